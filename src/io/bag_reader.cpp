@@ -1,0 +1,192 @@
+#include "io/bag_reader.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "io/error.hpp"
+#include "io/ros_messages.hpp"
+#include "io/ros_pointcloud.hpp"
+
+namespace drover::io {
+namespace {
+
+constexpr const char* kStreamNames[] = {"lidar", "imu", "image"};
+
+struct AcceptedType {
+  std::string_view type, md5;
+};
+
+std::vector<AcceptedType> acceptedTypes(int stream) {
+  switch (stream) {
+    case 0: return {{ros::kPointCloud2, ros::kPointCloud2Md5}};
+    case 1: return {{ros::kImu, ros::kImuMd5}};
+    default: return {{ros::kImage, ros::kImageMd5}, {ros::kCompressedImage, ros::kCompressedImageMd5}};
+  }
+}
+
+std::string timeString(Time t) {
+  std::string ns = std::to_string(t % kNanosPerSecond);
+  return std::to_string(t / kNanosPerSecond) + "." + std::string(9 - ns.size(), '0') + ns;
+}
+
+bool heapAfter(Time ta, std::uint64_t sa, Time tb, std::uint64_t sb) { return ta > tb || (ta == tb && sa > sb); }
+
+}  // namespace
+
+BagReader::BagReader(const std::string& path, const DatasetOptions& options)
+    : path_(path), options_(options), file_(std::make_unique<bag::BagFile>(path)) {
+  index_ = file_->readIndex();
+  if (index_.scanned)
+    warnings_.push_back("bag is not indexed (the recording was not closed cleanly): read by scanning its chunks" +
+                        (index_.unread_tail_bytes > 0
+                             ? "; the last " + std::to_string(index_.unread_tail_bytes) + " bytes were incomplete"
+                             : std::string()));
+  topics_[kLidar] = options.load_lidar ? options.lidar_topic : "";
+  topics_[kImu] = options.load_imu ? options.imu_topic : "";
+  topics_[kImage] = options.load_images ? options.image_topic : "";
+  std::fill(std::begin(latest_), std::end(latest_), std::numeric_limits<Time>::min());
+  last_returned_ = std::numeric_limits<Time>::min();
+  selectConnections();
+}
+
+void BagReader::selectConnections() {
+  struct Use {
+    Stream stream;
+    bool compressed;
+  };
+  std::map<std::uint32_t, Use> uses;
+  bool found[kStreamCount] = {false, false, false};
+  for (const bag::Connection& c : index_.connections) {
+    for (int s = 0; s < kStreamCount; ++s) {
+      if (topics_[s].empty() || c.topic != topics_[s]) continue;
+      std::string expected;
+      bool ok = false;
+      for (const AcceptedType& a : acceptedTypes(s)) {
+        expected += (expected.empty() ? "" : " or ") + std::string(a.type);
+        if (c.type != a.type) continue;
+        if (c.md5sum != "*" && c.md5sum != a.md5)
+          fail(path_, "topic " + c.topic, "message type " + c.type + " has md5sum " + c.md5sum + ", expected " +
+                                              std::string(a.md5) + " (a different message definition)");
+        ok = true;
+      }
+      if (!ok)
+        fail(path_, "topic " + c.topic, "configured as the " + std::string(kStreamNames[s]) + " topic but has type " +
+                                            c.type + ", expected " + expected);
+      uses[c.id] = {static_cast<Stream>(s), c.type == ros::kCompressedImage};
+      found[s] = true;
+    }
+  }
+  bool any_enabled = false, any_found = false;
+  for (int s = 0; s < kStreamCount; ++s) {
+    any_enabled = any_enabled || !topics_[s].empty();
+    any_found = any_found || found[s];
+    if (!topics_[s].empty() && !found[s])
+      warnings_.push_back(std::string(kStreamNames[s]) + " topic " + topics_[s] + " is not in the bag");
+  }
+  if (any_enabled && !any_found) {
+    std::set<std::string> present;
+    for (const bag::Connection& c : index_.connections) present.insert(c.topic + " (" + c.type + ")");
+    std::string list;
+    for (const std::string& p : present) list += (list.empty() ? "" : ", ") + p;
+    fail(path_, "", "none of the configured topics (lidar '" + topics_[kLidar] + "', imu '" + topics_[kImu] +
+                        "', image '" + topics_[kImage] + "') is in the bag; it contains: " +
+                        (list.empty() ? "no topics" : list));
+  }
+  std::uint32_t per_topic[kStreamCount] = {0, 0, 0};
+  for (const bag::IndexEntry& e : index_.entries) {
+    const auto it = uses.find(e.conn);
+    if (it == uses.end()) continue;
+    const Stream s = it->second.stream;
+    selected_.push_back({e, s, it->second.compressed, per_topic[s]++});
+  }
+  for (int s = 0; s < kStreamCount; ++s) remaining_[s] = total_[s] = per_topic[s];
+  // The selection holds all we need; free the full index of long bags.
+  std::vector<bag::IndexEntry>().swap(index_.entries);
+}
+
+std::string BagReader::record(const Selected& s) const {
+  return "topic " + topics_[s.stream] + " message " + std::to_string(s.topic_index) + ", bag time " +
+         timeString(s.entry.time);
+}
+
+void BagReader::decodeNext() {
+  const Selected& sel = selected_[cursor_++];
+  const auto [data, size] = file_->messageData(index_, sel.entry);
+  Measurement m;
+  try {
+    if (sel.stream == kLidar) {
+      ros::DecodedCloud cloud = ros::decodePointCloud2(data, size);
+      stats_.nonfinite_points_dropped += cloud.dropped_nonfinite;
+      m = std::move(cloud.scan);
+    } else if (sel.stream == kImu) {
+      m = ros::decodeImu(data, size);
+    } else {
+      CameraFrame f = sel.compressed_image ? ros::decodeCompressedImage(data, size) : ros::decodeImage(data, size);
+      f.source = path_ + ":" + topics_[kImage] + "#" + std::to_string(sel.topic_index);
+      m = std::move(f);
+    }
+  } catch (const ros::MessageError& e) {
+    fail(path_, record(sel), e.what());
+  }
+  const Time t = measurementTime(m);
+  if (t <= latest_[sel.stream])
+    fail(path_, record(sel), "time " + timeString(t) + " is not after the previous message's " +
+                                 timeString(latest_[sel.stream]) + " on this topic (backwards or duplicate stamp)");
+  latest_[sel.stream] = t;
+  --remaining_[sel.stream];
+  ++stats_.messages_decoded;
+  heap_.push_back({std::move(m), t, sel.entry.time, seq_++, &sel});
+  std::push_heap(heap_.begin(), heap_.end(),
+                 [](const Pending& a, const Pending& b) { return heapAfter(a.t, a.seq, b.t, b.seq); });
+}
+
+bool BagReader::releasable() const {
+  const Pending& top = heap_.front();
+  if (cursor_ < selected_.size() && selected_[cursor_].entry.time - top.record_time > kReorderWindow) return true;
+  for (int s = 0; s < kStreamCount; ++s)
+    if (remaining_[s] > 0 && latest_[s] < top.t) return false;  // stream s may still bring an earlier stamp
+  return true;
+}
+
+Measurement BagReader::pop() {
+  std::pop_heap(heap_.begin(), heap_.end(),
+                [](const Pending& a, const Pending& b) { return heapAfter(a.t, a.seq, b.t, b.seq); });
+  Pending p = std::move(heap_.back());
+  heap_.pop_back();
+  if (p.t < last_returned_)
+    fail(path_, record(*p.source),
+         "header stamp " + timeString(p.t) + " is earlier than the already returned measurement at " +
+             timeString(last_returned_) + ": its stamp lags the bag record time by more than " +
+             std::to_string(kReorderWindow / kNanosPerSecond) + " s relative to the other topics");
+  last_returned_ = p.t;
+  return std::move(p.m);
+}
+
+std::optional<Measurement> BagReader::next() {
+  while (true) {
+    if (!heap_.empty() && releasable()) return pop();
+    if (cursor_ < selected_.size()) {
+      decodeNext();
+      continue;
+    }
+    if (heap_.empty()) return std::nullopt;
+    return pop();
+  }
+}
+
+std::string BagReader::describe() const {
+  std::string s = "ROS bag " + path_ + ":";
+  for (int k = 0; k < kStreamCount; ++k)
+    if (!topics_[k].empty()) s += std::string(" ") + kStreamNames[k] + " " + topics_[k] + " (" +
+                                  std::to_string(total_[k]) + " msgs)";
+  for (const std::string& w : warnings_) s += "; " + w;
+  return s;
+}
+
+std::unique_ptr<Reader> openBag(const std::string& path, const DatasetOptions& options) {
+  return std::make_unique<BagReader>(path, options);
+}
+
+}  // namespace drover::io
