@@ -1,5 +1,243 @@
+// drover eval: trajectory accuracy against ground truth, with evo's definitions (APE, RPE) and the KITTI
+// odometry devkit's segment drift. The maths is in src/eval; this file reads the files, prints and writes.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
 #include "apps/drover/commands.hpp"
+#include "apps/drover/eval_report.hpp"
+#include "io/trajectory_io.hpp"
 
 namespace drover::cli {
-void registerEval(CLI::App& app) { app.add_subcommand("eval", "Evaluate a trajectory against ground truth"); }
+namespace {
+
+struct CommonOptions {
+  std::string ref, est;
+  std::string format = "tum";
+  std::string align = "none";
+  double t_max_diff = 0.01;  // [s]
+  double t_offset = 0.0;     // [s]
+  std::string relation = "trans";
+  std::string ref_times, est_times;
+  std::string plot, json;
+};
+
+struct RpeCliOptions {
+  CommonOptions common;
+  double delta = 1.0;
+  std::string delta_unit = "frames";
+  bool pairs_from_reference = false;
+};
+
+eval::Alignment parseAlignment(const std::string& s) {
+  if (s == "se3") return eval::Alignment::kSe3;
+  if (s == "sim3") return eval::Alignment::kSim3;
+  return eval::Alignment::kNone;
+}
+
+eval::PoseRelation parseRelation(const std::string& s) {
+  if (s == "rot") return eval::PoseRelation::kRotation;
+  if (s == "full") return eval::PoseRelation::kFull;
+  if (s == "angle_deg") return eval::PoseRelation::kAngleDeg;
+  return eval::PoseRelation::kTranslation;
+}
+
+std::optional<std::string> optionalPath(const std::string& s) {
+  return s.empty() ? std::nullopt : std::optional<std::string>(s);
+}
+
+// Output files are checked before the work so a typo does not cost a long evaluation.
+void requireWritableParent(const std::string& path, const char* option) {
+  if (path.empty()) return;
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent))
+    throw std::invalid_argument(fmt::format("{} {}: folder {} does not exist", option, path, parent.string()));
+}
+
+eval::AssociationOptions associationOptions(const CommonOptions& o) {
+  if (!std::isfinite(o.t_max_diff) || o.t_max_diff < 0)
+    throw std::invalid_argument(fmt::format("--t-max-diff must be >= 0 s, got {}", o.t_max_diff));
+  if (!std::isfinite(o.t_offset)) throw std::invalid_argument("--t-offset must be finite");
+  return {fromSeconds(o.t_max_diff), fromSeconds(o.t_offset)};
+}
+
+void loadBoth(const CommonOptions& o, Trajectory& ref, Trajectory& est) {
+  const io::TrajectoryFormat format = io::parseTrajectoryFormat(o.format);
+  requireWritableParent(o.json, "--json");
+  requireWritableParent(o.plot, "--plot");
+  ref = io::readTrajectory(o.ref, format, optionalPath(o.ref_times));
+  est = io::readTrajectory(o.est, format, optionalPath(o.est_times));
+  spdlog::info("loaded {} reference poses from {}, {} estimated poses from {}", ref.size(), o.ref, est.size(), o.est);
+}
+
+Json commonJson(const char* metric, const CommonOptions& o, eval::PoseRelation relation, std::size_t pairs,
+                std::size_t max_pairs, const eval::ErrorStatistics& s, eval::Alignment alignment,
+                const eval::Sim3& transform) {
+  Json j;
+  j["metric"] = metric;
+  j["reference"] = o.ref;
+  j["estimate"] = o.est;
+  j["pose_relation"] = eval::relationName(relation);
+  j["unit"] = eval::relationUnit(relation);
+  const Json stats = statisticsJson(s);
+  for (auto it = stats.begin(); it != stats.end(); ++it) j[it.key()] = it.value();
+  j["pairs"] = pairs;
+  j["max_pairs"] = max_pairs;
+  j["t_max_diff_s"] = o.t_max_diff;
+  j["t_offset_s"] = o.t_offset;
+  j["alignment"] = eval::alignmentName(alignment);
+  j["alignment_transform"] = alignmentJson(transform);
+  return j;
+}
+
+void printResult(const std::string& title, std::size_t pairs, std::size_t max_pairs, const eval::ErrorStatistics& s) {
+  fmt::print("{}\n\nmatched pose pairs: {} of max. {}\nvalues: {}\n\n{}", title, pairs, max_pairs, s.count,
+             statisticsTable(s));
+}
+
+// Errors at the estimate poses est_aligned[k] for k in `at`; the reference path for context.
+PlotData plotData(const std::string& title, const char* unit, const std::vector<Time>& times,
+                  const std::vector<double>& errors, const Trajectory& est_aligned, const std::vector<std::size_t>& at,
+                  const Trajectory& ref, const std::vector<std::size_t>& ref_index) {
+  PlotData d;
+  d.title = title;
+  d.unit = unit;
+  d.times = times;
+  d.errors = errors;
+  for (const std::size_t k : at) d.est_at_errors.push_back(est_aligned[k].T_world_body.translation());
+  for (const std::size_t i : ref_index) d.ref_path.push_back(ref[i].T_world_body.translation());
+  return d;
+}
+
+void runApe(const CommonOptions& o) {
+  Trajectory ref, est;
+  loadBoth(o, ref, est);
+  eval::ApeOptions options{parseRelation(o.relation), parseAlignment(o.align), associationOptions(o)};
+  const eval::ApeResult r = eval::computeApe(ref, est, options);
+  printResult(apeTitle(r), r.pairs, r.max_pairs, r.stats);
+  if (!o.json.empty()) {
+    const Json j = commonJson("ape", o, r.relation, r.pairs, r.max_pairs, r.stats, r.alignment, r.alignment_transform);
+    io::writeFileAtomically(o.json, j.dump(2) + "\n");
+  }
+  if (!o.plot.empty()) {
+    std::vector<std::size_t> all(r.pairs);
+    for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+    writePlot(plotData(apeTitle(r), eval::relationUnit(r.relation), r.times, r.errors, r.est_aligned, all, ref,
+                       r.association.first),
+              o.plot);
+  }
+}
+
+void runRpe(const RpeCliOptions& c) {
+  const CommonOptions& o = c.common;
+  Trajectory ref, est;
+  loadBoth(o, ref, est);
+  eval::RpeOptions options;
+  options.relation = parseRelation(o.relation);
+  options.alignment = parseAlignment(o.align);
+  options.association = associationOptions(o);
+  options.delta = c.delta;
+  options.unit =
+      (c.delta_unit == "meters" || c.delta_unit == "m") ? eval::DeltaUnit::kMeters : eval::DeltaUnit::kFrames;
+  options.pairs_from_reference = c.pairs_from_reference;
+  const eval::RpeResult r = eval::computeRpe(ref, est, options);
+  printResult(rpeTitle(r, options), r.pairs, r.max_pairs, r.stats);
+  if (!o.json.empty()) {
+    Json j = commonJson("rpe", o, r.relation, r.pairs, r.max_pairs, r.stats, r.alignment, r.alignment_transform);
+    j["delta"] = c.delta;
+    j["delta_unit"] = options.unit == eval::DeltaUnit::kFrames ? "frames" : "meters";
+    j["pairs_from"] = options.pairs_from_reference ? "reference" : "estimate";
+    io::writeFileAtomically(o.json, j.dump(2) + "\n");
+  }
+  if (!o.plot.empty()) {
+    std::vector<std::size_t> second;
+    for (const auto& pair : r.id_pairs) second.push_back(pair.second);
+    writePlot(plotData(rpeTitle(r, options), eval::relationUnit(r.relation), r.times, r.errors, r.est_aligned, second,
+                       ref, r.association.first),
+              o.plot);
+  }
+}
+
+std::vector<Eigen::Isometry3d> posesOf(const Trajectory& t) {
+  std::vector<Eigen::Isometry3d> poses;
+  poses.reserve(t.size());
+  for (const auto& p : t) poses.push_back(p.T_world_body);
+  return poses;
+}
+
+void runKitti(const CommonOptions& o) {
+  Trajectory ref, est;
+  loadBoth(o, ref, est);
+  if (ref.size() != est.size())
+    throw std::invalid_argument(fmt::format("KITTI drift matches poses by index: {} has {} poses but {} has {}", o.ref,
+                                            ref.size(), o.est, est.size()));
+  const eval::KittiDriftResult r = eval::computeKittiDrift(posesOf(ref), posesOf(est));
+  fmt::print("{}", kittiTable(r));
+  if (!o.json.empty()) {
+    Json j = kittiJson(r);
+    j["reference"] = o.ref;
+    j["estimate"] = o.est;
+    io::writeFileAtomically(o.json, j.dump(2) + "\n");
+  }
+}
+
+void addInputs(CLI::App* cmd, CommonOptions& o, const char* default_format) {
+  o.format = default_format;
+  cmd->add_option("ref", o.ref, "Reference (ground-truth) trajectory file")->required();
+  cmd->add_option("est", o.est, "Estimated trajectory file")->required();
+  cmd->add_option("--format", o.format, "Trajectory file format")->capture_default_str()
+      ->check(CLI::IsMember({"tum", "kitti", "euroc"}));
+  cmd->add_option("--ref-times", o.ref_times, "KITTI times.txt of the reference (seconds, one a line)");
+  cmd->add_option("--est-times", o.est_times, "KITTI times.txt of the estimate");
+  cmd->add_option("--json", o.json, "Write the figures as JSON to this file");
+}
+
+void addMetricOptions(CLI::App* cmd, CommonOptions& o) {
+  cmd->add_option("--align", o.align, "Umeyama alignment of the estimate onto the reference")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "se3", "sim3"}));
+  cmd->add_option("--t-max-diff", o.t_max_diff, "Largest time difference of an associated pair [s]")
+      ->capture_default_str();
+  cmd->add_option("--t-offset", o.t_offset, "Time offset added to the estimate's stamps [s]")->capture_default_str();
+  cmd->add_option("--pose-relation", o.relation, "Error measure")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"trans", "rot", "full", "angle_deg"}));
+  cmd->add_option("--plot", o.plot, "Write a PNG plot: error over time and the trajectory from above");
+}
+
+}  // namespace
+
+void registerEval(CLI::App& app) {
+  auto* eval = app.add_subcommand("eval", "Evaluate a trajectory against ground truth (APE, RPE, KITTI drift)");
+  eval->require_subcommand(1);
+
+  auto ape = std::make_shared<CommonOptions>();
+  auto* ape_cmd = eval->add_subcommand("ape", "Absolute pose error, as evo_ape");
+  addInputs(ape_cmd, *ape, "tum");
+  addMetricOptions(ape_cmd, *ape);
+  ape_cmd->callback([ape] { runApe(*ape); });
+
+  auto rpe = std::make_shared<RpeCliOptions>();
+  auto* rpe_cmd = eval->add_subcommand("rpe", "Relative pose error with consecutive pairs, as evo_rpe");
+  addInputs(rpe_cmd, rpe->common, "tum");
+  addMetricOptions(rpe_cmd, rpe->common);
+  rpe_cmd->add_option("--delta", rpe->delta, "Distance between the poses of a pair")->capture_default_str();
+  rpe_cmd->add_option("--delta-unit", rpe->delta_unit, "Unit of --delta")->capture_default_str()
+      ->check(CLI::IsMember({"frames", "meters", "f", "m"}));
+  rpe_cmd->add_flag("--pairs-from-reference", rpe->pairs_from_reference,
+                    "With --delta-unit meters, measure the path on the reference (evo default: the estimate)");
+  rpe_cmd->callback([rpe] { runRpe(*rpe); });
+
+  auto kitti = std::make_shared<CommonOptions>();
+  auto* kitti_cmd = eval->add_subcommand("kitti", "KITTI odometry devkit drift: t_err % and r_err deg/100 m");
+  addInputs(kitti_cmd, *kitti, "kitti");
+  kitti_cmd->callback([kitti] { runKitti(*kitti); });
+}
+
 }  // namespace drover::cli
