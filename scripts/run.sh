@@ -15,7 +15,7 @@ if [ ! -d "$SEQ" ]; then
 fi
 mkdir -p "$OUT"
 DROVER="$BUILD_DIR/apps/drover/drover"
-"$DROVER" info "$SEQ" --format kitti --config config/kitti.yaml --json "$OUT/info.json" \
+"$DROVER" info "$SEQ" --format kitti --config config/kitti.yaml --max-frames 10 --json "$OUT/info.json" \
   --export-gt "$OUT/groundtruth_lidar.tum"
 # The evaluator end to end on the exported file (a self-check: every statistic must print 0). It will compare
 # Drover's own trajectory here once `drover run` exists.

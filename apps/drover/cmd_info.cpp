@@ -25,6 +25,7 @@ struct InfoOptions {
   std::string config;
   std::string json;
   std::string export_gt;
+  std::size_t max_frames = 0;
 };
 
 // Count, first and last stamp of one sensor's stream.
@@ -211,7 +212,8 @@ std::string summaryText(const Json& j, const Summary& s, const io::Reader& reade
 }
 
 void runInfo(const InfoOptions& o) {
-  const io::DatasetOptions options = o.config.empty() ? io::DatasetOptions{} : io::loadDatasetOptions(o.config);
+  io::DatasetOptions options = o.config.empty() ? io::DatasetOptions{} : io::loadDatasetOptions(o.config);
+  if (o.max_frames > 0) options.kitti_max_frames = o.max_frames;
   const std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, options);
   const Summary summary = streamDataset(*reader);
   const Json j = summaryJson(o, *reader, summary);
@@ -237,6 +239,7 @@ void registerInfo(CLI::App& app) {
   cmd->add_option("--config", o->config, "Platform config (config/*.yaml): topics, sensors to load, calibration");
   cmd->add_option("--json", o->json, "Also write the summary as JSON to this file");
   cmd->add_option("--export-gt", o->export_gt, "Write the ground truth (T_world_body) as a TUM file");
+  cmd->add_option("--max-frames", o->max_frames, "KITTI odometry: read only the first N frames (0 = all)");
   cmd->callback([o] { runInfo(*o); });
 }
 

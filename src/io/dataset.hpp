@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -12,6 +13,9 @@ struct DatasetOptions {
   bool load_imu = true;
   bool load_images = true;
   int kitti_camera = 2;  // KITTI odometry image folder: 0 = image_0 (grey left), 2 = image_2 (colour left)
+  // KITTI odometry: read only the first N frames of times.txt (0 = all). Lets a snippet that holds the first
+  // frames of a sequence be read; without it a frame listed in times.txt but missing on disk is an error.
+  std::size_t kitti_max_frames = 0;
   // ROS1 bag topics (LVI-SAM defaults).
   std::string lidar_topic = "/points_raw";
   std::string imu_topic = "/imu_raw";

@@ -42,6 +42,8 @@ KittiOdometryReader::KittiOdometryReader(const std::string& sequence_dir, const 
   requireFolder(dir, "KITTI odometry sequence folder not found");
   times_ = readTimesFile((dir / "times.txt").string());
   if (times_.empty()) fail((dir / "times.txt").string(), "", "no frames listed");
+  if (options_.kitti_max_frames > 0 && options_.kitti_max_frames < times_.size())
+    times_.resize(options_.kitti_max_frames);
   if (options_.load_lidar) requireFolder(dir / "velodyne", "velodyne folder missing (or set load_lidar: false)");
   if (options_.load_images)
     requireFolder(dir / imageFolder(),

@@ -34,7 +34,9 @@ std::size_t countFiles(const fs::path& dir, const std::string& ext) {
 std::string findCalib(const fs::path& drive, const std::string& name) {
   if (fs::exists(drive / name)) return (drive / name).string();
   const fs::path p = drive.parent_path() / name;
-  if (!fs::exists(p)) fail(p.string(), "", "calibration file not found (looked in the drive folder and its parent)");
+  if (!fs::exists(p))
+    fail((drive / name).string(), "", "calibration file not found, neither here nor in the parent folder " +
+                                          drive.parent_path().string());
   return p.string();
 }
 

@@ -130,11 +130,20 @@ Trajectory readTrajectory(const std::string& path, TrajectoryFormat format,
   throw std::invalid_argument("unknown trajectory format");
 }
 
+namespace {
+// q and -q are the same rotation; writing the one with w >= 0 makes files deterministic and diffable.
+Eigen::Quaterniond canonicalQuaternion(const Eigen::Matrix3d& R) {
+  Eigen::Quaterniond q = Eigen::Quaterniond(R).normalized();
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  return q;
+}
+}  // namespace
+
 void writeTum(const std::string& path, const Trajectory& trajectory) {
   validateForWrite(trajectory, path);
   std::string out = "# t[s] x y z qx qy qz qw (T_world_body)\n";
   for (const auto& p : trajectory) {
-    const Eigen::Quaterniond q = Eigen::Quaterniond(p.T_world_body.linear()).normalized();
+    const Eigen::Quaterniond q = canonicalQuaternion(p.T_world_body.linear());
     const Eigen::Vector3d& x = p.T_world_body.translation();
     out += formatSeconds(p.t) + " " + joinNumbers({x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()}, " ") + "\n";
   }
@@ -159,7 +168,7 @@ void writeEurocCsv(const std::string& path, const Trajectory& trajectory) {
   validateForWrite(trajectory, path);
   std::string out = "#timestamp [ns],p_RS_R_x [m],p_RS_R_y [m],p_RS_R_z [m],q_RS_w [],q_RS_x [],q_RS_y [],q_RS_z []\n";
   for (const auto& p : trajectory) {
-    const Eigen::Quaterniond q = Eigen::Quaterniond(p.T_world_body.linear()).normalized();
+    const Eigen::Quaterniond q = canonicalQuaternion(p.T_world_body.linear());
     const Eigen::Vector3d& x = p.T_world_body.translation();
     out += std::to_string(p.t) + "," + joinNumbers({x.x(), x.y(), x.z(), q.w(), q.x(), q.y(), q.z()}, ",") + "\n";
   }

@@ -140,6 +140,22 @@ TEST(InfoCli, SummarisesTenKittiFrames) {
   EXPECT_NEAR(j["ground_truth"]["path_length_m"].get<double>(), 7.738659335084388, 1e-6);
 }
 
+TEST(InfoCli, MaxFramesReadsTheSnippetInPlaceAndWithoutItTheMissingScanIsNamed) {
+  DROVER_REQUIRE_SHARED(kKitti00);
+  TempDir dir;
+  const CliResult ok = runDrover("info " + kKitti00.string() + " --format kitti --max-frames 10 --json " +
+                                 (dir / "info.json").string());
+  ASSERT_EQ(ok.exit_code, 0) << ok.output;
+  const Json j = readJson(dir / "info.json");
+  EXPECT_EQ(j["lidar"]["count"], 10);
+  EXPECT_EQ(j["camera"]["count"], 10);
+  EXPECT_EQ(j["lidar"]["last_time_ns"].get<std::int64_t>(), 933146700);
+  // times.txt lists 4541 frames but the snippet stops at 000009.bin: reading all of it is an error at frame 10.
+  const CliResult bad = runDrover("info " + kKitti00.string() + " --format kitti");
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.output.find("000010.bin (frame 10)"), std::string::npos) << bad.output;
+}
+
 TEST(InfoCli, MissingDatasetExitsWith2NamingThePath) {
   TempDir dir;
   const std::string missing = (dir / "no_such_sequence").string();

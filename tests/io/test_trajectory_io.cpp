@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "io/error.hpp"
 #include "support/shared_data.hpp"
@@ -112,6 +114,30 @@ TEST(TrajectoryIo, TumNormalisesSlightlyNonUnitQuaternion) {
   const Eigen::Quaterniond q(t[0].T_world_body.linear());
   EXPECT_NEAR(q.norm(), 1.0, 1e-12);
   EXPECT_NEAR(std::abs(q.z()), 0.7071 / std::hypot(0.7071, 0.7075), 1e-12);
+}
+
+TEST(TrajectoryIo, WritersPutQuaternionsInTheHemisphereWithNonNegativeW) {
+  TempDir dir;
+  Trajectory traj(1);
+  traj[0].t = 1'000'000'000;
+  // 170 deg about -z: the trace is negative, so Eigen's matrix->quaternion makes the dominant component (z)
+  // positive and returns w = -cos(85 deg) < 0. The file must hold the twin with w = +cos(85 deg).
+  traj[0].T_world_body.linear() = Eigen::AngleAxisd(170.0 * M_PI / 180.0, -Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (const auto format : {TrajectoryFormat::kTum, TrajectoryFormat::kEuroc}) {
+    const std::string path = (dir / "q.txt").string();
+    writeTrajectory(path, format, traj);
+    std::ifstream in(path);
+    std::string header, line;
+    std::getline(in, header);
+    std::getline(in, line);
+    for (char& c : line) c = c == ',' ? ' ' : c;
+    std::istringstream fields(line);
+    double v[8];
+    for (double& x : v) fields >> x;
+    const double w = format == TrajectoryFormat::kTum ? v[7] : v[4];
+    EXPECT_NEAR(w, std::cos(85.0 * M_PI / 180.0), 1e-9) << line;
+    expectSame(readTrajectory(path, format), traj, true);
+  }
 }
 
 TEST(TrajectoryIo, RejectsMissingFile) {
