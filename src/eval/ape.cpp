@@ -46,15 +46,21 @@ std::vector<double> absoluteErrors(const Trajectory& ref, const std::vector<std:
   return errors;
 }
 
+MatchedTrajectories matchAndAlign(const Trajectory& ref, const Trajectory& est, const AssociationOptions& association,
+                                  Alignment alignment) {
+  MatchedTrajectories m;
+  m.alignment = alignment;
+  m.association = associateForEvaluation(ref, est, association);
+  m.pairs = m.association.size();
+  m.max_pairs = m.association.max_pairs;
+  m.alignment_transform = alignTrajectory(est, m.association.second, ref, m.association.first, alignment, m.est_aligned);
+  return m;
+}
+
 ApeResult computeApe(const Trajectory& ref, const Trajectory& est, const ApeOptions& options) {
   ApeResult r;
   r.relation = options.relation;
-  r.alignment = options.alignment;
-  r.association = associateForEvaluation(ref, est, options.association);
-  r.pairs = r.association.size();
-  r.max_pairs = r.association.max_pairs;
-  r.alignment_transform =
-      alignTrajectory(est, r.association.second, ref, r.association.first, options.alignment, r.est_aligned);
+  static_cast<MatchedTrajectories&>(r) = matchAndAlign(ref, est, options.association, options.alignment);
   r.errors = absoluteErrors(ref, r.association.first, r.est_aligned, options.relation);
   r.stats = computeStatistics(r.errors);
   r.times.reserve(r.pairs);

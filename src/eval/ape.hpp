@@ -18,17 +18,25 @@ struct ApeOptions {
   AssociationOptions association;  // reference first, estimate second (evo: traj_ref, traj_est)
 };
 
-struct ApeResult {
-  ErrorStatistics stats;
-  std::vector<double> errors;  // one per matched pair, in the unit of relationUnit(relation)
-  std::vector<Time> times;     // the estimate's stamps of the matched pairs [ns]
-  PoseRelation relation = PoseRelation::kTranslation;
+// Reference and estimate matched by time and the estimate aligned: the first step of APE and RPE.
+struct MatchedTrajectories {
   Alignment alignment = Alignment::kNone;
   Sim3 alignment_transform;    // est -> ref; identity for kNone
   std::size_t pairs = 0;       // matched pose pairs
   std::size_t max_pairs = 0;   // the shorter trajectory's length
   Association association;     // pair k: ref[association.first[k]] with est[association.second[k]]
   Trajectory est_aligned;      // est_aligned[k]: the matched estimate pose k after alignment (for plots)
+};
+
+// Throws as associateForEvaluation and alignTrajectory do.
+MatchedTrajectories matchAndAlign(const Trajectory& ref, const Trajectory& est, const AssociationOptions& association,
+                                  Alignment alignment);
+
+struct ApeResult : MatchedTrajectories {
+  ErrorStatistics stats;
+  std::vector<double> errors;  // one per matched pair, in the unit of relationUnit(relation)
+  std::vector<Time> times;     // the estimate's stamps of the matched pairs [ns]
+  PoseRelation relation = PoseRelation::kTranslation;
 };
 
 // Throws std::invalid_argument when no pose pairs match, or when alignment is asked for and the matched

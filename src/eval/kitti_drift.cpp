@@ -2,24 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 #include <string>
 
+#include "eval/message.hpp"
 #include "geometry/se3.hpp"
 
 namespace drover::eval {
-
-namespace {
-
-// Short human form of a number for error messages ("1.5", "100", "40.1434").
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-}  // namespace
 
 std::vector<double> trajectoryDistances(const std::vector<Eigen::Isometry3d>& poses) {
   std::vector<double> dist;
@@ -55,7 +45,7 @@ void validate(const std::vector<Eigen::Isometry3d>& gt, const std::vector<Eigen:
   if (o.lengths.empty()) throw std::invalid_argument("KITTI drift: no segment lengths");
   for (const double l : o.lengths)
     if (!(l > 0.0) || !std::isfinite(l))
-      throw std::invalid_argument("KITTI drift: segment length must be > 0, got " + num(l));
+      throw std::invalid_argument("KITTI drift: segment length must be > 0, got " + shortNumber(l));
 }
 
 }  // namespace
@@ -80,8 +70,8 @@ KittiDriftResult computeKittiDrift(const std::vector<Eigen::Isometry3d>& gt, con
   if (r.segments.empty()) {
     const double shortest = *std::min_element(options.lengths.begin(), options.lengths.end());
     throw std::invalid_argument("KITTI drift: no segment fits: the ground-truth path is " +
-                                num(r.path_length) + " m, the shortest segment length " +
-                                num(shortest) + " m");
+                                shortNumber(r.path_length) + " m, the shortest segment length " +
+                                shortNumber(shortest) + " m");
   }
   constexpr double kRadToDeg = 180.0 / std::numbers::pi;
   double t_sum = 0.0, r_sum = 0.0;

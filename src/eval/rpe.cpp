@@ -1,28 +1,21 @@
 #include "eval/rpe.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <stdexcept>
 #include <string>
 
+#include "eval/message.hpp"
 #include "geometry/se3.hpp"
 
 namespace drover::eval {
 
 namespace {
 
-// Short human form of a number for error messages ("1.5", "100").
-std::string num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%g", v);
-  return buf;
-}
-
 // evo's filter_pairs_by_path on n positions given by an accessor.
 template <typename Position>
 IdPairs pathPairs(std::size_t n, const Position& position, double delta) {
   if (!(delta > 0.0) || !std::isfinite(delta))
-    throw std::invalid_argument("RPE delta must be > 0 m, got " + num(delta));
+    throw std::invalid_argument("RPE delta must be > 0 m, got " + shortNumber(delta));
   std::vector<std::size_t> ids;
   double path = 0.0;
   for (std::size_t i = 1; i < n; ++i) {
@@ -81,7 +74,7 @@ IdPairs selectPairs(const Trajectory& ref, const std::vector<std::size_t>& ref_i
                     const RpeOptions& o) {
   if (o.unit == DeltaUnit::kFrames) {
     if (!(o.delta >= 1.0) || o.delta != std::floor(o.delta) || o.delta > 1e15)
-      throw std::invalid_argument("RPE delta in frames must be a positive integer, got " + num(o.delta));
+      throw std::invalid_argument("RPE delta in frames must be a positive integer, got " + shortNumber(o.delta));
     return pairsByIndex(est_aligned.size(), static_cast<std::size_t>(o.delta));
   }
   // evo measures the path on the aligned estimate (alignment happens before the pair search).
@@ -93,16 +86,11 @@ IdPairs selectPairs(const Trajectory& ref, const std::vector<std::size_t>& ref_i
 RpeResult computeRpe(const Trajectory& ref, const Trajectory& est, const RpeOptions& options) {
   RpeResult r;
   r.relation = options.relation;
-  r.alignment = options.alignment;
-  r.association = associateForEvaluation(ref, est, options.association);
-  r.pairs = r.association.size();
-  r.max_pairs = r.association.max_pairs;
-  r.alignment_transform =
-      alignTrajectory(est, r.association.second, ref, r.association.first, options.alignment, r.est_aligned);
+  static_cast<MatchedTrajectories&>(r) = matchAndAlign(ref, est, options.association, options.alignment);
   r.id_pairs = selectPairs(ref, r.association.first, r.est_aligned, options);
   if (r.id_pairs.empty())
     throw std::invalid_argument(
-        "RPE delta = " + num(options.delta) + (options.unit == DeltaUnit::kFrames ? " frames" : " m") +
+        "RPE delta = " + shortNumber(options.delta) + (options.unit == DeltaUnit::kFrames ? " frames" : " m") +
         " selects no pose pair among " + std::to_string(r.pairs) + " matched poses; try a smaller delta");
   r.errors = relativeErrors(ref, r.association.first, r.est_aligned, r.id_pairs, options.relation);
   r.stats = computeStatistics(r.errors);

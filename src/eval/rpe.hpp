@@ -28,18 +28,13 @@ struct RpeOptions {
 
 using IdPairs = std::vector<std::pair<std::size_t, std::size_t>>;
 
-struct RpeResult {
+// MatchedTrajectories::pairs counts the matched poses before the delta selection.
+struct RpeResult : MatchedTrajectories {
   ErrorStatistics stats;
   std::vector<double> errors;  // one per pair
   std::vector<Time> times;     // the estimate's stamp at the second pose j of each pair [ns]
   IdPairs id_pairs;            // indices k into the matched pairs (see association)
   PoseRelation relation = PoseRelation::kTranslation;
-  Alignment alignment = Alignment::kNone;
-  Sim3 alignment_transform;
-  std::size_t pairs = 0;      // matched pose pairs (before the delta selection)
-  std::size_t max_pairs = 0;  // the shorter trajectory's length
-  Association association;    // matched pair k: ref[association.first[k]], est[association.second[k]]
-  Trajectory est_aligned;     // matched estimate poses after alignment
 };
 
 // Consecutive index pairs (evo filter_pairs_by_index, all_pairs = False). delta >= 1.

@@ -9,6 +9,7 @@
 #include "io/error.hpp"
 #include "io/kitti_fixture_util.hpp"
 #include "support/shared_data.hpp"
+#include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
@@ -18,15 +19,7 @@ namespace fs = std::filesystem;
 using test::TempDir;
 using test::writeText;
 
-template <typename F>
-void expectIoError(F&& f, std::initializer_list<std::string> fragments) {
-  try {
-    f();
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
-    for (const auto& s : fragments) EXPECT_NE(std::string(e.what()).find(s), std::string::npos) << e.what();
-  }
-}
+using test::expectIoError;
 
 // The first `n` numbers after "key:" in a KITTI calib file, parsed independently of the reader.
 std::vector<double> calibValues(const fs::path& file, const std::string& key) {

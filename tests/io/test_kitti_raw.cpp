@@ -9,6 +9,7 @@
 #include "io/error.hpp"
 #include "io/kitti_fixture_util.hpp"
 #include "io/kitti_oxts.hpp"
+#include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
@@ -22,15 +23,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kEr = 6378137.0;
 constexpr Time kT0 = 1317386421LL * kNanosPerSecond;  // 2011-09-30 12:40:21 read as UTC (timegm)
 
-template <typename F>
-void expectIoError(F&& f, std::initializer_list<std::string> fragments) {
-  try {
-    f();
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
-    for (const auto& s : fragments) EXPECT_NE(std::string(e.what()).find(s), std::string::npos) << e.what();
-  }
-}
+using test::expectIoError;
 
 // The fixture's motion: a circle at 10 m/s with yaw rate 0.2 rad/s, climbing 0.5 m/s, constant roll and pitch;
 // x east, y north (metres from the start), yaw from east.

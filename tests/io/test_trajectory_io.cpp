@@ -9,6 +9,7 @@
 
 #include "io/error.hpp"
 #include "support/shared_data.hpp"
+#include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
@@ -41,16 +42,7 @@ void expectSame(const Trajectory& a, const Trajectory& b, bool compare_times) {
   }
 }
 
-// Expects an IoError whose message contains every fragment.
-template <typename F>
-void expectIoError(F&& f, std::initializer_list<std::string> fragments) {
-  try {
-    f();
-    FAIL() << "expected IoError";
-  } catch (const IoError& e) {
-    for (const auto& s : fragments) EXPECT_NE(std::string(e.what()).find(s), std::string::npos) << e.what();
-  }
-}
+using test::expectIoError;
 
 TEST(TrajectoryIo, ParsesFormatNames) {
   EXPECT_EQ(parseTrajectoryFormat("tum"), TrajectoryFormat::kTum);
