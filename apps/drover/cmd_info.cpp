@@ -231,11 +231,12 @@ void runInfo(const InfoOptions& o) {
 void registerInfo(CLI::App& app) {
   auto* cmd = app.add_subcommand("info", "Summarise a dataset's measurement stream, calibration and ground truth");
   auto o = std::make_shared<InfoOptions>();
-  cmd->add_option("dataset", o->dataset, "Dataset folder (KITTI sequence/drive, EuRoC sequence) or bag file")
+  cmd->add_option("dataset", o->dataset,
+                  "Dataset folder (KITTI sequence/drive, EuRoC sequence, drover sim output) or bag file")
       ->required();
   cmd->add_option("--format", o->format, "Dataset format")
       ->required()
-      ->check(CLI::IsMember({"kitti", "kitti-raw", "euroc", "bag"}));
+      ->check(CLI::IsMember({"kitti", "kitti-raw", "euroc", "bag", "sim"}));
   cmd->add_option("--config", o->config, "Platform config (config/*.yaml): topics, sensors to load, calibration");
   cmd->add_option("--json", o->json, "Also write the summary as JSON to this file");
   cmd->add_option("--export-gt", o->export_gt, "Write the ground truth (T_world_body) as a TUM file");

@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   spdlog::set_pattern("%^[%l]%$ %v");
   drover::cli::registerEval(app);
   drover::cli::registerInfo(app);
+  drover::cli::registerSim(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -24,8 +24,8 @@ struct DatasetOptions {
   Calibration calibration;
 };
 
-// format: kitti | kitti-raw | euroc | bag. Throws IoError for a missing or malformed dataset and
-// std::invalid_argument for an unknown format.
+// format: kitti | kitti-raw | euroc | bag | sim (Drover's simulated dataset, io/sim_dataset.hpp). Throws IoError
+// for a missing or malformed dataset and std::invalid_argument for an unknown format.
 std::unique_ptr<Reader> openDataset(const std::string& path, const std::string& format,
                                     const DatasetOptions& options);
 

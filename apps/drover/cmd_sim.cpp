@@ -1,0 +1,176 @@
+// drover sim: generate a simulated dataset (lidar, camera, IMU, ground truth) that `--format sim` reads back.
+// The simulation is in src/sim, the folder format in src/io/sim_dataset.hpp; this file parses, reports progress.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "apps/drover/commands.hpp"
+#include "io/sim_dataset.hpp"
+#include "io/trajectory_io.hpp"
+#include "sim/scenario.hpp"
+#include "sim/simulator.hpp"
+
+namespace drover::cli {
+namespace {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct SimOptions {
+  std::string scenario, out, format = "folder", config, lidar, kitti_poses, kitti_times;
+  std::uint64_t seed = 1;
+  double duration = 0;     // [s], 0 = the scenario's natural length
+  double camera_rate = 0;  // [Hz], 0 = config / default
+  bool no_camera = false, force = false, quiet = false;
+};
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+// ../shared/data: $DROVER_SHARED_DIR/data, then ../shared/data from the current folder, then beside the sources.
+std::optional<fs::path> sharedData() {
+  std::vector<fs::path> candidates;
+  if (const char* env = std::getenv("DROVER_SHARED_DIR")) candidates.push_back(fs::path(env) / "data");
+  candidates.push_back(fs::path("..") / "shared" / "data");
+  candidates.push_back(fs::path(DROVER_SOURCE_DIR) / ".." / "shared" / "data");
+  for (const fs::path& c : candidates)
+    if (fs::is_directory(c)) return c;
+  return std::nullopt;
+}
+
+// KITTI 05 ground truth (camera-0 poses with times) for kitti05-replay.
+Trajectory loadKitti05(const SimOptions& o) {
+  const std::optional<fs::path> data = sharedData();
+  std::string poses = o.kitti_poses, times = o.kitti_times;
+  if (poses.empty() && data) poses = (*data / "kitti" / "poses" / "05.txt").string();
+  if (times.empty() && data) times = (*data / "kitti" / "sequences" / "05" / "times.txt").string();
+  if (poses.empty() || times.empty())
+    throw std::invalid_argument(
+        "kitti05-replay needs KITTI 05 poses and times: ../shared/data not found; pass --kitti-poses and "
+        "--kitti-times");
+  return io::readKitti(poses, times);
+}
+
+sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
+  sim::SimulatorConfig c = sim::SimulatorConfig::defaults();
+  io::SimConfigSettings s;
+  if (!o.config.empty()) s = io::loadSimConfigSettings(o.config);
+  c.lidar = sim::LidarModelConfig::forModel(!o.lidar.empty() ? o.lidar : s.lidar_model.value_or("vlp16"));
+  if (s.lidar_rate_hz) c.lidar.rate_hz = *s.lidar_rate_hz;
+  if (s.lidar_columns) c.lidar.columns = *s.lidar_columns;
+  if (s.camera_rate_hz) c.camera.rate_hz = *s.camera_rate_hz;
+  if (o.camera_rate > 0) c.camera.rate_hz = o.camera_rate;
+  if (s.camera_color) c.camera.color = *s.camera_color;
+  if (s.imu_rate_hz) c.imu.rate_hz = *s.imu_rate_hz;
+  if (s.ground_truth_rate_hz) c.ground_truth_rate_hz = *s.ground_truth_rate_hz;
+  if (s.lidar_time_offset_s) c.lidar_time_offset = fromSeconds(*s.lidar_time_offset_s);
+  if (s.camera_time_offset_s) c.camera_time_offset = fromSeconds(*s.camera_time_offset_s);
+  if (s.noise && !*s.noise) c.lidar.noise = c.camera.noise = c.imu.noise = false;
+  c.enable_camera = !o.no_camera;
+  if (std::string e = c.validate(); !e.empty()) throw std::invalid_argument("simulator settings: " + e);
+  return c;
+}
+
+void checkOptions(const SimOptions& o) {
+  const std::vector<std::string> names = sim::scenarioNames();
+  if (std::find(names.begin(), names.end(), o.scenario) == names.end())
+    throw std::invalid_argument("unknown scenario '" + o.scenario + "' (expected one of: " + joined(names) + ")");
+  if (!std::isfinite(o.duration) || o.duration < 0)
+    throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
+  if (!std::isfinite(o.camera_rate) || o.camera_rate < 0)
+    throw std::invalid_argument(fmt::format("--camera-rate must be > 0 Hz, got {}", o.camera_rate));
+  if (fs::exists(o.out) && !o.force)
+    throw std::invalid_argument("output folder " + o.out + " already exists (use --force to replace it)");
+}
+
+// Prints "t / T s (p%), x sim-s/s, ETA" about every 2 s of wall time.
+class Progress {
+ public:
+  Progress(Time start, Time end) : start_(start), end_(end), wall_start_(Clock::now()), last_print_(wall_start_) {}
+  void update(Time t) {
+    const auto now = Clock::now();
+    if (now - last_print_ < std::chrono::seconds(2)) return;
+    last_print_ = now;
+    const double done = toSeconds(t - start_), total = toSeconds(end_ - start_);
+    const double rate = done / std::max(1e-9, wallSeconds());
+    spdlog::info("sim {:.1f} / {:.1f} s ({:.0f}%), {:.2f} sim-s/s, ETA {:.0f} s", done, total,
+                 100.0 * done / std::max(1e-9, total), rate, rate > 0 ? (total - done) / rate : 0.0);
+  }
+  double wallSeconds() const { return std::chrono::duration<double>(Clock::now() - wall_start_).count(); }
+
+ private:
+  Time start_, end_;
+  Clock::time_point wall_start_, last_print_;
+};
+
+void runSim(const SimOptions& o) {
+  if (o.quiet) spdlog::set_level(spdlog::level::err);
+  checkOptions(o);
+  const sim::SimulatorConfig config = simulatorConfig(o);
+  Trajectory kitti05;
+  sim::ScenarioOptions so;
+  so.seed = o.seed;
+  so.duration_s = o.duration;
+  if (o.scenario == "kitti05-replay") {
+    kitti05 = loadKitti05(o);
+    so.kitti05_ground_truth = &kitti05;
+  }
+  const sim::Scenario scenario = sim::makeScenario(o.scenario, so);
+  const sim::Simulator simulator(scenario, config, o.seed);
+  const sim::Simulator::Counts expected = simulator.expectedCounts();
+  spdlog::info("simulating '{}' (seed {}, {:.1f} s, {:.0f} m): {} IMU samples, {} {} sweeps, {} frames -> {}",
+               o.scenario, o.seed, toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime()),
+               scenario.trajectory->pathLength(), expected.imu, expected.lidar, config.lidar.model, expected.camera,
+               o.out);
+  io::SimWriterOptions wo;
+  wo.overwrite = o.force;
+  io::SimDatasetWriter writer(o.out, simulator.datasetDescription(), wo);
+  Progress progress(scenario.trajectory->startTime(), scenario.trajectory->endTime());
+  simulator.run([&](Measurement&& m) {
+    progress.update(measurementTime(m));
+    writer.add(std::move(m));
+  });
+  writer.finish(simulator.groundTruth());
+  const io::SimWriterCounts& c = writer.counts();
+  const double sim_s = toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime());
+  const double wall = progress.wallSeconds();
+  spdlog::info("wrote {}: {} IMU samples, {} scans ({:.0f} points each), {} frames; {:.1f} s simulated in {:.1f} s "
+               "({:.2f} sim-s/s)",
+               o.out, c.imu, c.lidar, c.lidar ? static_cast<double>(c.lidar_points) / c.lidar : 0.0, c.camera, sim_s,
+               wall, sim_s / std::max(1e-9, wall));
+}
+
+}  // namespace
+
+void registerSim(CLI::App& app) {
+  auto* cmd = app.add_subcommand("sim", "Generate a simulated dataset (lidar, camera, IMU, ground truth)");
+  auto o = std::make_shared<SimOptions>();
+  cmd->add_option("--scenario", o->scenario, "Scenario: " + joined(sim::scenarioNames()))->required();
+  cmd->add_option("--out", o->out, "Output folder (written as OUT.partial, renamed when complete)")->required();
+  cmd->add_option("--seed", o->seed, "Random seed: the same seed gives byte-identical output")->capture_default_str();
+  cmd->add_option("--duration", o->duration, "Seconds to simulate (0 = the scenario's natural length)");
+  cmd->add_option("--lidar", o->lidar, "Lidar model (default vlp16 or the config's)")
+      ->check(CLI::IsMember({"vlp16", "vlp32", "hdl64"}));
+  cmd->add_option("--camera-rate", o->camera_rate, "Camera frame rate [Hz] (default 15 or the config's)");
+  cmd->add_option("--format", o->format, "Output format")->check(CLI::IsMember({"folder"}))->capture_default_str();
+  cmd->add_option("--config", o->config, "Platform config with a sim: section (config/farm_sim.yaml)");
+  cmd->add_option("--kitti-poses", o->kitti_poses, "kitti05-replay: KITTI poses file (default ../shared/data)");
+  cmd->add_option("--kitti-times", o->kitti_times, "kitti05-replay: KITTI times.txt (default ../shared/data)");
+  cmd->add_flag("--no-camera", o->no_camera, "Do not render camera images");
+  cmd->add_flag("--force", o->force, "Replace an existing output folder");
+  cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
+  cmd->callback([o] { runSim(*o); });
+}
+
+}  // namespace drover::cli

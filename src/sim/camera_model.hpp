@@ -1,0 +1,106 @@
+#pragma once
+// Pinhole camera with radial-tangential distortion, rendered by casting one ray per pixel into the textured world.
+// Brightness = texture colour * illumination(t, hit) * Lambert(normal) where a surface is hit, sky * illumination
+// where nothing is, then Gaussian read noise and 8-bit quantisation (linear: grey = 255 * value, no gamma).
+// Optional motion blur averages sub-frames over the exposure time.
+//
+// Pixel convention (as OpenCV / Kalibr): integer pixel coordinates are pixel centres, so pixel (u, v) spans
+// [u - 0.5, u + 0.5] x [v - 0.5, v + 0.5] and the image spans [-0.5, width - 0.5] x [-0.5, height - 0.5].
+// Camera frame: z forward, x right, y down.
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sim/trajectory.hpp"
+#include "sim/world.hpp"
+#include "types/calibration.hpp"
+#include "types/camera.hpp"
+
+namespace drover::sim {
+
+// Scene lighting at time t and world point p: a factor on the surface colour (1 = daylight, 0.05 = dark barn).
+// Scenarios supply it (dark segments, exposure ramps, flicker); the default is uniform daylight.
+using Illumination = std::function<float(Time t, const Eigen::Vector3d& p_world)>;
+
+struct CameraModelConfig {
+  CameraIntrinsics intrinsics = defaultIntrinsics();  // 640x480, fx = fy = 460, rad-tan (EuRoC-like)
+  double rate_hz = 15.0;               // [Hz]
+  double exposure_s = 0.01;            // [s] exposure time (for motion blur), < 1 / rate_hz
+  int motion_blur_samples = 1;         // 1 = no blur; N sub-frames averaged over the exposure (<= 64)
+  double noise_sigma = 2.0;            // [grey levels of 255], Gaussian read noise
+  bool color = false;                  // false: mono8 (as most VIO cameras); true: bgr8
+  Eigen::Vector3f sky = Eigen::Vector3f(0.7f, 0.8f, 0.95f);  // linear RGB where no surface is hit (outdoors)
+  bool noise = true;
+  // 640x480, fx = fy = 460, cx = 319.5, cy = 239.5, rad-tan k1 = -0.28, k2 = 0.07, p1 = 2e-4, p2 = -1e-4.
+  static CameraIntrinsics defaultIntrinsics();
+  // Empty when valid, else names the bad value. Supports DistortionModel::kNone and kRadialTangential (4 or 5
+  // coefficients k1 k2 p1 p2 [k3]); kEquidistant is rejected.
+  std::string validate() const;
+};
+
+// Lens distortion on normalised image coordinates xn = (x / z, y / z) (Brown-Conrady, as OpenCV and Kalibr
+// "radtan"): r2 = |xn|^2, radial = 1 + k1 r2 + k2 r2^2 + k3 r2^3,
+//   xd = x radial + 2 p1 x y + p2 (r2 + 2 x^2),   yd = y radial + p1 (r2 + 2 y^2) + 2 p2 x y.
+// J_xd_xn, when given, receives the Jacobian d xd / d xn. kNone returns xn (J = identity).
+Eigen::Vector2d distortNormalized(const CameraIntrinsics& intrinsics, const Eigen::Vector2d& xn,
+                                  Eigen::Matrix2d* J_xd_xn = nullptr);
+// Inverse of distortNormalized by Newton's method started at xd; nothing when |distort(xn) - xd| does not fall
+// below `tolerance` (normalised units) within 50 iterations.
+std::optional<Eigen::Vector2d> undistortNormalized(const CameraIntrinsics& intrinsics, const Eigen::Vector2d& xd,
+                                                   double tolerance);
+
+// The fixed directional light of the renderer (world frame, unit, pointing towards the light): a sun 60 deg above
+// the horizon at azimuth 30 deg from world x towards y, i.e. (cos 60 cos 30, cos 60 sin 30, sin 60). The same
+// direction is used indoors, where it stands for light through doors and openings; the scenario's Illumination
+// carries the light level.
+inline Eigen::Vector3d sunDirectionWorld() {
+  return {std::numbers::sqrt3 / 4.0, 0.25, std::numbers::sqrt3 / 2.0};
+}
+// Lambert shading factor of a surface with unit normal n_world: 0.35 + 0.65 * |n . sun| (ambient + diffuse;
+// the absolute value lights both sides of thin walls the same way). In [0.35, 1].
+inline float lambertFactor(const Eigen::Vector3d& n_world) {
+  const double cos_incidence = n_world.dot(sunDirectionWorld());
+  return 0.35f + 0.65f * static_cast<float>(std::abs(cos_incidence));
+}
+
+// Precomputes one unit ray direction per pixel in the camera frame (undistorting each pixel centre), so a frame
+// is one intersect() per pixel. Thread-safe render().
+class CameraRenderer {
+ public:
+  // Throws std::invalid_argument when config.validate() fails or a pixel cannot be undistorted.
+  explicit CameraRenderer(const CameraModelConfig& config);
+  // Renders the frame exposed at t (mid-exposure) from T_world_body(t) * T_body_cam. Rows render in parallel;
+  // noise is counter-based (seed, frame_index, pixel), so output is identical for any thread count. With motion
+  // blur, sub-frame i of N is at t + exposure * ((i + 0.5) / N - 0.5), clamped to the trajectory's span.
+  // An empty `illumination` means uniform daylight (1). Throws std::out_of_range when t is outside the trajectory.
+  CameraFrame render(const World& world, const SplineTrajectory& trajectory, const Eigen::Isometry3d& T_body_cam,
+                     const Illumination& illumination, Time t, std::uint64_t seed, std::uint64_t frame_index) const;
+  const CameraModelConfig& config() const { return config_; }
+
+  // Pixel [px] of a camera-frame point: distort + K. Nothing when the point is not in front of the camera
+  // (z <= 1e-9 m), lies outside the field of view the image covers, or falls outside the image bounds.
+  std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& p_cam) const;
+  // Unit ray in the camera frame through pixel coordinates `pixel` [px] (undistorted to 1e-10 px).
+  // Throws std::invalid_argument when the distortion model cannot be inverted there.
+  Eigen::Vector3d unproject(const Eigen::Vector2d& pixel) const;
+  // The precomputed unit ray through the centre of pixel (u, v) (float precision).
+  const Eigen::Vector3f& ray(int u, int v) const { return rays_cam_[static_cast<std::size_t>(v) * width_ + u]; }
+
+ private:
+  struct SubFrame;
+  void renderRow(const World& world, const std::vector<SubFrame>& subframes, const Illumination& illumination,
+                 int v, std::uint64_t seed, std::uint64_t frame_index, std::uint8_t* row) const;
+
+  CameraModelConfig config_;
+  std::size_t width_ = 0;
+  double max_r2_ = 0;                      // largest |xn|^2 of any pixel, with margin (limits project())
+  std::vector<Eigen::Vector3f> rays_cam_;  // unit ray per pixel, row-major, camera frame (z forward)
+};
+
+}  // namespace drover::sim

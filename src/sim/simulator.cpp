@@ -1,0 +1,242 @@
+// The simulator: runs the IMU, lidar and camera models over a scenario and merges their output in time order.
+#include "sim/simulator.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <sstream>
+#include <stdexcept>
+
+#include "io/sim_dataset.hpp"
+#include "sim/random.hpp"
+
+namespace drover::sim {
+namespace {
+
+// Time of event k of a periodic stream: start + k / rate, rounded to the ns (no accumulated drift).
+Time periodic(Time start, std::size_t k, double rate_hz) {
+  return start + static_cast<Time>(std::llround(static_cast<double>(k) * 1e9 / rate_hz));
+}
+
+bool isRigid(const Eigen::Isometry3d& T) {
+  const Eigen::Matrix3d R = T.linear();
+  return T.matrix().allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < 1e-9 &&
+         R.determinant() > 0;
+}
+
+// One scheduled measurement: its stamp, its sensor (0 = IMU, 1 = lidar, 2 = camera: the tie order) and its index
+// in that sensor's stream.
+struct Slot {
+  Time stamp = 0;
+  int sensor = 0;
+  std::size_t index = 0;
+  bool operator<(const Slot& o) const {
+    if (stamp != o.stamp) return stamp < o.stamp;
+    if (sensor != o.sensor) return sensor < o.sensor;
+    return index < o.index;
+  }
+};
+
+// The whole schedule by stamp (cheap: times only); sensor stamps are true times minus the offsets.
+std::vector<Slot> buildSchedule(const std::vector<ImuSample>& imu, const std::vector<Time>& sweeps,
+                                const std::vector<Time>& frames, Time lidar_offset, Time camera_offset) {
+  std::vector<Slot> schedule;
+  schedule.reserve(imu.size() + sweeps.size() + frames.size());
+  for (std::size_t i = 0; i < imu.size(); ++i) schedule.push_back({imu[i].t, 0, i});
+  for (std::size_t i = 0; i < sweeps.size(); ++i) schedule.push_back({sweeps[i] - lidar_offset, 1, i});
+  for (std::size_t i = 0; i < frames.size(); ++i) schedule.push_back({frames[i] - camera_offset, 2, i});
+  std::sort(schedule.begin(), schedule.end());
+  return schedule;
+}
+
+}  // namespace
+
+SimulatorConfig SimulatorConfig::defaults() {
+  SimulatorConfig c;
+  c.camera.intrinsics = CameraModelConfig::defaultIntrinsics();
+  c.T_imu_lidar = Eigen::Isometry3d::Identity();
+  c.T_imu_lidar.translation() = Eigen::Vector3d(0.05, 0.0, 0.30);  // [m]
+  // Columns: the camera's x, y, z axes in the body frame (x right = -body y, y down = -body z, z forward = body x).
+  Eigen::Matrix3d R_imu_camnominal;
+  R_imu_camnominal << 0, 0, 1,  //
+      -1, 0, 0,                 //
+      0, -1, 0;
+  // A deliberate ~1 deg mounting error about a generic axis, so the extrinsics are not axis-aligned.
+  const Eigen::AngleAxisd misalignment(1.0 * std::numbers::pi / 180.0, Eigen::Vector3d(0.3, -0.5, 0.8).normalized());
+  c.T_imu_cam = Eigen::Isometry3d::Identity();
+  c.T_imu_cam.linear() = R_imu_camnominal * misalignment.toRotationMatrix();
+  c.T_imu_cam.translation() = Eigen::Vector3d(0.20, 0.0, 0.10);  // [m]
+  c.lidar_time_offset = 0;
+  c.camera_time_offset = 5'000'000;  // [ns]: camera stamps are 5 ms early (t_imu = t_cam + 5 ms)
+  return c;
+}
+
+std::string SimulatorConfig::validate() const {
+  std::ostringstream e;
+  if (!enable_imu && !enable_lidar && !enable_camera) return "at least one sensor must be enabled";
+  if (enable_lidar)
+    if (std::string s = lidar.validate(); !s.empty()) return "lidar: " + s;
+  if (enable_camera)
+    if (std::string s = camera.validate(); !s.empty()) return "camera: " + s;
+  if (enable_imu)
+    if (std::string s = imu.validate(); !s.empty()) return "imu: " + s;
+  if (!(ground_truth_rate_hz >= 100.0) || !std::isfinite(ground_truth_rate_hz)) {
+    e << "ground_truth_rate_hz must be >= 100, got " << ground_truth_rate_hz;
+  } else if (!isRigid(T_imu_lidar)) {
+    e << "T_imu_lidar is not a rigid transform";
+  } else if (!isRigid(T_imu_cam)) {
+    e << "T_imu_cam is not a rigid transform";
+  } else if (std::abs(lidar_time_offset) > kNanosPerSecond || std::abs(camera_time_offset) > kNanosPerSecond) {
+    e << "time offsets must be within 1 s, got lidar " << lidar_time_offset << " ns, camera " << camera_time_offset
+      << " ns";
+  }
+  return e.str();
+}
+
+Simulator::Simulator(const Scenario& scenario, const SimulatorConfig& config, std::uint64_t seed)
+    : scenario_(scenario), config_(config), seed_(seed) {
+  if (std::string e = config.validate(); !e.empty()) throw std::invalid_argument("SimulatorConfig: " + e);
+  if (!scenario.trajectory) throw std::invalid_argument("scenario '" + scenario.name + "' has no trajectory");
+}
+
+Calibration Simulator::calibration() const {
+  Calibration c;
+  c.T_imu_lidar = config_.T_imu_lidar;
+  c.T_imu_cam = config_.T_imu_cam;
+  c.camera = config_.camera.intrinsics;
+  c.lidar_time_offset = config_.lidar_time_offset;
+  c.camera_time_offset = config_.camera_time_offset;
+  return c;
+}
+
+Trajectory Simulator::groundTruth() const { return scenario_.trajectory->sample(config_.ground_truth_rate_hz); }
+
+std::vector<Time> Simulator::sweepStarts() const {
+  std::vector<Time> t;
+  if (!config_.enable_lidar) return t;
+  const Time start = scenario_.trajectory->startTime(), end = scenario_.trajectory->endTime();
+  const Time period = static_cast<Time>(std::llround(1e9 / config_.lidar.rate_hz));
+  for (std::size_t k = 0;; ++k) {
+    const Time t0 = periodic(start, k, config_.lidar.rate_hz);
+    if (t0 + period > end) break;
+    t.push_back(t0);
+  }
+  return t;
+}
+
+std::vector<Time> Simulator::frameTimes() const {
+  std::vector<Time> t;
+  if (!config_.enable_camera) return t;
+  const Time start = scenario_.trajectory->startTime(), end = scenario_.trajectory->endTime();
+  const Time half_exposure = fromSeconds(config_.camera.exposure_s / 2);
+  for (std::size_t k = 0;; ++k) {
+    const Time mid = periodic(start + half_exposure, k, config_.camera.rate_hz);
+    if (mid + half_exposure > end) break;
+    t.push_back(mid);
+  }
+  return t;
+}
+
+Simulator::Counts Simulator::expectedCounts() const {
+  Counts c;
+  if (config_.enable_imu) {
+    const Time start = scenario_.trajectory->startTime(), end = scenario_.trajectory->endTime();
+    while (periodic(start, c.imu, config_.imu.rate_hz) <= end) ++c.imu;
+  }
+  c.lidar = sweepStarts().size();
+  c.camera = frameTimes().size();
+  return c;
+}
+
+void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) const {
+  if (chunk <= 0) throw std::invalid_argument("Simulator::run: chunk must be positive, got " + std::to_string(chunk));
+  const SplineTrajectory& trajectory = *scenario_.trajectory;
+  const std::uint64_t imu_seed = hashKeys(seed_, static_cast<std::uint64_t>(Stream::kImu));
+  const std::uint64_t lidar_seed = hashKeys(seed_, static_cast<std::uint64_t>(Stream::kLidar));
+  const std::uint64_t camera_seed = hashKeys(seed_, static_cast<std::uint64_t>(Stream::kCamera));
+
+  std::vector<ImuSample> imu;
+  if (config_.enable_imu) imu = simulateImu(trajectory, config_.imu, imu_seed);
+  const std::vector<Time> sweeps = sweepStarts();
+  const std::vector<Time> frames = frameTimes();
+  std::optional<CameraRenderer> renderer;
+  if (config_.enable_camera) renderer.emplace(config_.camera);
+
+  const std::vector<Slot> schedule =
+      buildSchedule(imu, sweeps, frames, config_.lidar_time_offset, config_.camera_time_offset);
+  // One sweep or frame, stamped with the sensor's clock.
+  const auto compute = [&](const Slot& s) -> Measurement {
+    if (s.sensor == 1) {
+      LidarScan scan = simulateSweep(scenario_.world, trajectory, config_.T_imu_lidar, sweeps[s.index], config_.lidar,
+                                     lidar_seed, s.index);
+      const Time duration = scan.t_end - scan.t;
+      scan.t = s.stamp;
+      scan.t_end = s.stamp + duration;
+      return scan;
+    }
+    CameraFrame frame = renderer->render(scenario_.world, trajectory, config_.T_imu_cam, scenario_.illumination,
+                                         frames[s.index], camera_seed, s.index);
+    frame.t = s.stamp;
+    return frame;
+  };
+  std::size_t begin = 0;
+  while (begin < schedule.size()) {
+    const Time chunk_end = schedule[begin].stamp + chunk;
+    std::size_t end = begin;
+    while (end < schedule.size() && schedule[end].stamp < chunk_end) ++end;
+    // Sweeps and frames of this chunk, computed in parallel into their slots.
+    std::vector<std::size_t> heavy;
+    for (std::size_t i = begin; i < end; ++i)
+      if (schedule[i].sensor != 0) heavy.push_back(i);
+    std::vector<std::optional<Measurement>> results(heavy.size());
+    tbb::parallel_for(std::size_t{0}, heavy.size(), [&](std::size_t h) { results[h] = compute(schedule[heavy[h]]); });
+    std::size_t h = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (schedule[i].sensor == 0)
+        sink(Measurement(imu[schedule[i].index]));
+      else
+        sink(std::move(*results[h++]));
+    }
+    begin = end;
+  }
+}
+
+io::SimDatasetDescription Simulator::datasetDescription() const {
+  io::SimDatasetDescription d;
+  d.calibration = calibration();
+  io::SimSensorInfo& s = d.sensors;
+  s.lidar_model = config_.lidar.model;
+  s.lidar_rings = static_cast<int>(config_.lidar.elevations.size());
+  s.lidar_columns = config_.lidar.columns;
+  s.lidar_rate_hz = config_.lidar.rate_hz;
+  s.camera_rate_hz = config_.camera.rate_hz;
+  s.camera_channels = config_.camera.color ? 3 : 1;
+  s.camera_exposure_s = config_.camera.exposure_s;
+  const ImuModelConfig& imu = config_.imu;
+  s.imu_rate_hz = imu.rate_hz;
+  // The densities of the data as generated: zero when the model's noise is off.
+  s.gyro_noise_density = imu.noise ? imu.gyro_noise_density : 0.0;
+  s.accel_noise_density = imu.noise ? imu.accel_noise_density : 0.0;
+  s.gyro_bias_random_walk = imu.noise ? imu.gyro_bias_random_walk : 0.0;
+  s.accel_bias_random_walk = imu.noise ? imu.accel_bias_random_walk : 0.0;
+  s.ground_truth_rate_hz = config_.ground_truth_rate_hz;
+  io::SimScenarioInfo& sc = d.scenario;
+  const SplineTrajectory& trajectory = *scenario_.trajectory;
+  sc.name = scenario_.name;
+  sc.seed = seed_;
+  sc.duration_s = toSeconds(trajectory.endTime() - trajectory.startTime());
+  sc.path_length_m = trajectory.pathLength();
+  sc.closes_loop = scenario_.closes_loop;
+  sc.generator = kGeneratorVersion;
+  sc.has_imu = config_.enable_imu;
+  sc.has_lidar = config_.enable_lidar;
+  sc.has_camera = config_.enable_camera;
+  for (const Segment& seg : scenario_.segments)
+    sc.segments.push_back({conditionName(seg.condition), seg.start, seg.end});
+  return d;
+}
+
+}  // namespace drover::sim

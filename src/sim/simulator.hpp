@@ -1,0 +1,78 @@
+#pragma once
+// Runs the sensor models over a scenario and hands every measurement, in global time order, to a sink (the
+// dataset writer in io/, or a test). Sensor stamps include the configured time offsets: a sensor's stamp is
+// t_true - offset, so that t_imu = t_sensor + offset as Calibration defines it.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sim/camera_model.hpp"
+#include "sim/imu_model.hpp"
+#include "sim/lidar_model.hpp"
+#include "sim/scenario.hpp"
+#include "types/calibration.hpp"
+#include "types/measurement.hpp"
+#include "types/trajectory.hpp"
+
+namespace drover::io {
+struct SimDatasetDescription;  // io/sim_dataset.hpp (plain data; the sim library calls no io function)
+}
+
+namespace drover::sim {
+
+// Version of the generator, written into scenario.json; bump when the same seed would give different data.
+constexpr const char* kGeneratorVersion = "drover-sim 1";
+
+struct SimulatorConfig {
+  LidarModelConfig lidar = LidarModelConfig::forModel("vlp16");
+  CameraModelConfig camera;
+  ImuModelConfig imu;
+  bool enable_lidar = true, enable_camera = true, enable_imu = true;
+  // Extrinsics T_imu_sensor. defaults() sets those of a small ground robot: lidar 0.30 m above and 0.05 m ahead
+  // of the IMU, axes as the body's (x forward, y left, z up); camera 0.20 m ahead and 0.10 m up looking forward
+  // (camera z = body x, camera x = -body y, camera y = -body z) with a deliberate ~1 deg misalignment.
+  // A default-constructed config keeps identities.
+  Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_imu_cam = Eigen::Isometry3d::Identity();
+  // t_imu = t_sensor + offset [ns] (as Calibration): a sensor's stamp is t_true - offset. The IMU is the clock.
+  Time lidar_time_offset = 0;    // [ns]
+  Time camera_time_offset = 0;   // [ns]; defaults() sets 5 ms (camera stamps 5 ms early)
+  double ground_truth_rate_hz = 200.0;  // [Hz], >= 100
+  // The above with the robot's default extrinsics, offsets and camera intrinsics filled in.
+  static SimulatorConfig defaults();
+  std::string validate() const;  // empty when valid, else names the bad value
+};
+
+class Simulator {
+ public:
+  // Per-sensor seeds are hashKeys(seed, Stream::kImu | kLidar | kCamera). Throws std::invalid_argument when
+  // config.validate() fails or the scenario has no trajectory. Keeps a reference to `scenario`.
+  Simulator(const Scenario& scenario, const SimulatorConfig& config, std::uint64_t seed);
+  Calibration calibration() const;
+  Trajectory groundTruth() const;  // T_world_imu at ground_truth_rate_hz
+  // Generates everything in time order of the stamps (ties: IMU, then lidar, then camera). IMU samples come from
+  // simulateImu over the whole trajectory; sweep k starts at start + k / lidar rate while its end is inside the
+  // trajectory; frame k is exposed (mid-exposure) at start + exposure / 2 + k / camera rate while the exposure
+  // ends inside it. Work is done in chunks of `chunk` of stamp time: the chunk's sweeps and frames are computed
+  // in parallel (TBB, nested in the models' own row/column parallelism), then handed over in order, so memory
+  // holds one chunk of images. The sink is called from the calling thread only.
+  void run(const std::function<void(Measurement&&)>& sink, Time chunk = kNanosPerSecond) const;
+  // Counts run() will produce (for progress and tests).
+  struct Counts {
+    std::size_t imu = 0, lidar = 0, camera = 0;
+  };
+  Counts expectedCounts() const;
+  // What the dataset writer needs besides the measurements: calibration, sensor settings, scenario labels.
+  io::SimDatasetDescription datasetDescription() const;
+
+ private:
+  std::vector<Time> sweepStarts() const;  // true start times [ns]
+  std::vector<Time> frameTimes() const;   // true mid-exposure times [ns]
+
+  const Scenario& scenario_;
+  SimulatorConfig config_;
+  std::uint64_t seed_;
+};
+
+}  // namespace drover::sim

@@ -1,0 +1,107 @@
+// `drover sim` end to end: generate a short scenario, read it back with `drover info --format sim`; bad arguments
+// exit 2 with one clear line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "support/cli.hpp"
+#include "support/temp_dir.hpp"
+
+namespace drover::test {
+namespace {
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+Json readJson(const fs::path& p) {
+  std::ifstream in(p);
+  EXPECT_TRUE(in.good()) << p;
+  return Json::parse(in);
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(SimCli, GeneratesADatasetThatInfoReadsWithTheExpectedCounts) {
+  TempDir dir;
+  const fs::path out = dir / "straight";
+  const CliResult r = runDrover("sim --scenario straight --duration 1 --seed 3 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "sim-s/s")) << r.output;
+  const CliResult info = runDrover("info " + out.string() + " --format sim --json " + (dir / "info.json").string());
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const Json scenario = readJson(out / "scenario.json");
+  const double d = scenario["duration_s"].get<double>();  // the trajectory's span [s]
+  EXPECT_NEAR(d, 1.0, 0.5);
+  EXPECT_EQ(scenario["seed"], 3);
+  const Json j = readJson(dir / "info.json");
+  // IMU at 200 Hz over [0, d]; sweeps of 0.1 s that end by d; 15 Hz frames whose 10 ms exposure ends by d.
+  EXPECT_EQ(j["imu"]["count"].get<int>(), static_cast<int>(std::floor(d * 200 + 1e-9)) + 1);
+  EXPECT_EQ(j["lidar"]["count"].get<int>(), static_cast<int>(std::floor(d * 10 + 1e-9)));
+  EXPECT_EQ(j["camera"]["count"].get<int>(), static_cast<int>(std::floor((d - 0.01) * 15 + 1e-9)) + 1);
+  EXPECT_NEAR(j["imu"]["mean_rate_hz"].get<double>(), 200.0, 1e-6);
+  EXPECT_EQ(j["lidar"]["scans_with_time"], j["lidar"]["count"]);
+  EXPECT_EQ(j["lidar"]["scans_with_ring"], j["lidar"]["count"]);
+  EXPECT_GT(j["lidar"]["mean_points_per_scan"].get<double>(), 1000.0);
+  EXPECT_EQ(j["camera"]["width"], 640);
+  EXPECT_EQ(j["camera"]["height"], 480);
+  EXPECT_EQ(j["ground_truth"]["body_frame"], "imu");
+  EXPECT_EQ(j["ground_truth"]["count"], j["imu"]["count"]);  // both 200 Hz over the same span
+  EXPECT_NEAR(j["calibration"]["camera_time_offset_s"].get<double>(), 0.005, 1e-12);
+  EXPECT_NEAR(j["calibration"]["T_imu_lidar"][11].get<double>(), 0.30, 1e-12);  // lidar 0.30 m above the IMU
+  EXPECT_FALSE(fs::exists(dir / "straight.partial"));
+}
+
+TEST(SimCli, LidarModelAndNoCameraAreHonoured) {
+  TempDir dir;
+  const fs::path out = dir / "ds";
+  const CliResult r =
+      runDrover("sim -q --scenario straight --duration 1 --lidar hdl64 --no-camera --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_EQ(r.output, "") << "-q prints nothing on success";
+  const Json scenario = readJson(out / "scenario.json");
+  EXPECT_EQ(scenario["lidar_model"], "hdl64");
+  EXPECT_EQ(scenario["sensors"]["camera"], false);
+  const CliResult info = runDrover("info " + out.string() + " --format sim --json " + (dir / "info.json").string());
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const Json j = readJson(dir / "info.json");
+  EXPECT_EQ(j["camera"]["count"], 0);
+  EXPECT_GT(j["lidar"]["count"].get<int>(), 0);
+}
+
+TEST(SimCli, UnknownScenarioExitsWithCode2AndOneLine) {
+  TempDir dir;
+  const CliResult r = runDrover("sim --scenario moonbase --out " + (dir / "x").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.output, "unknown scenario 'moonbase'")) << r.output;
+  EXPECT_TRUE(contains(r.output, "farm")) << "lists the known scenarios: " << r.output;
+  EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "x"));
+}
+
+TEST(SimCli, ExistingOutputFolderNeedsForce) {
+  TempDir dir;
+  fs::create_directories(dir / "taken");
+  const std::string args = "sim --scenario straight --duration 1 --no-camera --out " + (dir / "taken").string();
+  const CliResult r = runDrover(args);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.output, "already exists")) << r.output;
+  EXPECT_TRUE(contains(r.output, "--force")) << r.output;
+  const CliResult forced = runDrover(args + " --force -q");
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_TRUE(fs::exists(dir / "taken" / "calibration.yaml"));
+}
+
+TEST(SimCli, BadArgumentsExitWithCode2) {
+  TempDir dir;
+  const std::string out = " --out " + (dir / "x").string();
+  EXPECT_EQ(runDrover("sim --scenario straight --duration -1" + out).exit_code, 2);
+  EXPECT_EQ(runDrover("sim --scenario straight --lidar vlp8" + out).exit_code, 2);
+  EXPECT_EQ(runDrover("sim --scenario straight --format bag" + out).exit_code, 2);
+  EXPECT_EQ(runDrover("sim --scenario straight --camera-rate 500 --duration 1" + out).exit_code, 2);
+  EXPECT_EQ(runDrover("sim --scenario straight").exit_code, 2);  // --out missing
+  EXPECT_FALSE(fs::exists(dir / "x"));
+}
+
+}  // namespace
+}  // namespace drover::test

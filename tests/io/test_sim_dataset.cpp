@@ -1,0 +1,366 @@
+// The simulated-dataset folder: writer -> reader round trip on hand-made measurements, and a clear error for
+// each kind of damage.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "io/config.hpp"
+#include "io/dataset.hpp"
+#include "io/sim_dataset.hpp"
+#include "io/text_parsing.hpp"
+#include "support/expect_io_error.hpp"
+#include "support/temp_dir.hpp"
+
+namespace drover::io {
+namespace {
+namespace fs = std::filesystem;
+using test::expectIoError;
+using test::TempDir;
+
+constexpr int kWidth = 8, kHeight = 6;
+
+SimDatasetDescription description() {
+  SimDatasetDescription d;
+  d.calibration.T_imu_lidar.translation() = Eigen::Vector3d(0.05, 0, 0.3);
+  d.calibration.T_imu_cam.linear() =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  d.calibration.T_imu_cam.translation() = Eigen::Vector3d(0.2, -0.01, 0.1);
+  d.calibration.camera_time_offset = 5'000'000;
+  d.calibration.lidar_time_offset = -123;
+  CameraIntrinsics& k = d.calibration.camera;
+  k.width = kWidth, k.height = kHeight, k.fx = 4.5, k.fy = 4.25, k.cx = 3.9, k.cy = 2.7;
+  k.distortion = DistortionModel::kRadialTangential;
+  k.distortion_coeffs = {-0.1, 0.01, 1e-4, -2e-4};
+  d.sensors.gyro_noise_density = 1.7e-4;
+  d.scenario.name = "hand-made";
+  d.scenario.seed = 42;
+  d.scenario.duration_s = 1.5;
+  d.scenario.segments = {{"straight", 0, 500}, {"white-walls", 400, 900}};
+  return d;
+}
+
+ImuSample imuAt(Time t) {
+  ImuSample s;
+  s.t = t;
+  s.omega_imu = Eigen::Vector3d(0.1 + 1e-17 * static_cast<double>(t), -1.0 / 3.0, std::sqrt(2.0));
+  s.acc_imu = Eigen::Vector3d(9.81, 1e-300, -0.1 * static_cast<double>(t));
+  s.q_world_imu = Eigen::Quaterniond(Eigen::AngleAxisd(0.001 * static_cast<double>(t), Eigen::Vector3d::UnitZ()));
+  return s;
+}
+
+LidarScan scanAt(Time t, int points) {
+  LidarScan scan;
+  scan.t = t;
+  scan.t_end = t + 100'000'000;
+  scan.has_time = scan.has_ring = true;
+  for (int i = 0; i < points; ++i) {
+    LidarPoint p;
+    p.x = 1.0f / static_cast<float>(i + 3), p.y = -7.25f * static_cast<float>(i), p.z = 1e-30f;
+    p.intensity = 255.0f / static_cast<float>(i + 1);
+    p.time_offset = static_cast<float>(i) * 0.0123f;
+    p.ring = static_cast<std::uint16_t>(i % 16);
+    scan.points.push_back(p);
+  }
+  return scan;
+}
+
+CameraFrame frameAt(Time t) {
+  CameraFrame f;
+  f.t = t;
+  f.image.width = kWidth, f.image.height = kHeight, f.image.channels = 1;
+  for (int i = 0; i < kWidth * kHeight; ++i) f.image.data.push_back(static_cast<std::uint8_t>(i * 5 + t % 7));
+  return f;
+}
+
+// IMU every 10 ns from 0 to 200, scans at 0, 100, 200 (ties with IMU), frames at 50, 100 (a three-way tie).
+std::vector<Measurement> measurements() {
+  std::vector<Measurement> m;
+  for (Time t = 0; t <= 200; t += 10) m.push_back(imuAt(t));
+  for (Time t = 0; t <= 200; t += 100) m.push_back(scanAt(t, 5));
+  m.push_back(frameAt(50));
+  m.push_back(frameAt(100));
+  return m;
+}
+
+Trajectory groundTruth() {
+  Trajectory gt;
+  for (Time t = 0; t <= 200; t += 5) {
+    StampedPose p;
+    p.t = t;
+    p.T_world_body.translation() = Eigen::Vector3d(0.1 * static_cast<double>(t), 2.0, -1.0 / 7.0);
+    p.T_world_body.linear() = Eigen::AngleAxisd(0.01 * static_cast<double>(t), Eigen::Vector3d::UnitZ()).matrix();
+    gt.push_back(p);
+  }
+  return gt;
+}
+
+fs::path writeDataset(const TempDir& tmp) {
+  const fs::path dir = tmp / "ds";
+  SimDatasetWriter w(dir.string(), description());
+  for (Measurement& m : measurements()) w.add(std::move(m));
+  w.finish(groundTruth());
+  return dir;
+}
+
+std::vector<Measurement> readAll(const fs::path& dir) {
+  auto reader = openDataset(dir.string(), "sim", DatasetOptions{});
+  std::vector<Measurement> out;
+  while (auto m = reader->next()) out.push_back(std::move(*m));
+  return out;
+}
+
+void replaceInFile(const fs::path& p, const std::string& from, const std::string& to) {
+  std::string text = readTextFile(p.string());
+  const auto pos = text.find(from);
+  ASSERT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  test::writeText(p, text);
+}
+
+TEST(SimDataset, RoundTripIsExactAndTimeOrderedWithTiesImuLidarCamera) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  const std::vector<Measurement> got = readAll(dir);
+  ASSERT_EQ(got.size(), 21u + 3u + 2u);
+  // At t = 100: IMU, then lidar, then camera.
+  std::vector<std::size_t> kinds_at_100;
+  for (const Measurement& m : got)
+    if (measurementTime(m) == 100) kinds_at_100.push_back(m.index());
+  EXPECT_EQ(kinds_at_100, (std::vector<std::size_t>{0, 1, 2}));
+  for (std::size_t i = 1; i < got.size(); ++i) EXPECT_LE(measurementTime(got[i - 1]), measurementTime(got[i]));
+  for (const Measurement& m : got) {
+    if (const auto* s = std::get_if<ImuSample>(&m)) {
+      const ImuSample e = imuAt(s->t);
+      EXPECT_EQ(s->omega_imu, e.omega_imu);  // shortest round-trip text: bit-exact
+      EXPECT_EQ(s->acc_imu, e.acc_imu);
+      ASSERT_TRUE(s->q_world_imu.has_value());
+      EXPECT_LT((s->q_world_imu->coeffs() - e.q_world_imu->coeffs()).norm(), 1e-15);
+    } else if (const auto* scan = std::get_if<LidarScan>(&m)) {
+      const LidarScan e = scanAt(scan->t, 5);
+      EXPECT_EQ(scan->t_end, e.t_end);
+      EXPECT_TRUE(scan->has_time && scan->has_ring);
+      ASSERT_EQ(scan->points.size(), e.points.size());
+      for (std::size_t i = 0; i < e.points.size(); ++i) {
+        const LidarPoint &a = scan->points[i], &b = e.points[i];
+        EXPECT_EQ(std::memcmp(&a.x, &b.x, 16), 0) << "x, y, z, intensity bit-exact, point " << i;
+        EXPECT_EQ(a.ring, b.ring);
+        EXPECT_NEAR(a.time_offset, b.time_offset, 0.6e-9 + 1e-7 * b.time_offset);  // stored as integer ns
+      }
+    } else {
+      const auto& f = std::get<CameraFrame>(m);
+      EXPECT_EQ(f.image.data, frameAt(f.t).image.data);
+      EXPECT_EQ(f.image.channels, 1);
+    }
+  }
+}
+
+TEST(SimDataset, CalibrationGroundTruthAndScenarioReadBack) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  auto reader = openSimDataset(dir.string(), DatasetOptions{});
+  const SimDatasetDescription d = description();
+  const Calibration& c = reader->calibration();
+  EXPECT_TRUE(c.T_imu_lidar.isApprox(d.calibration.T_imu_lidar, 1e-15));
+  EXPECT_TRUE(c.T_imu_cam.isApprox(d.calibration.T_imu_cam, 1e-15));
+  EXPECT_EQ(c.camera_time_offset, 5'000'000);
+  EXPECT_EQ(c.lidar_time_offset, -123);
+  EXPECT_EQ(c.camera.distortion, DistortionModel::kRadialTangential);
+  EXPECT_EQ(c.camera.distortion_coeffs, d.calibration.camera.distortion_coeffs);
+  EXPECT_EQ(c.camera.fx, 4.5);
+  EXPECT_EQ(c.camera.cy, 2.7);
+  const GroundTruth& gt = reader->groundTruth();
+  EXPECT_EQ(gt.body_frame, "imu");
+  const Trajectory e = groundTruth();
+  ASSERT_EQ(gt.poses.size(), e.size());
+  for (std::size_t i = 0; i < e.size(); ++i) {
+    EXPECT_EQ(gt.poses[i].t, e[i].t);
+    EXPECT_TRUE(gt.poses[i].T_world_body.isApprox(e[i].T_world_body, 1e-14));
+  }
+  const SimDatasetDescription r = readSimDescription(dir.string());
+  EXPECT_EQ(r.scenario.name, "hand-made");
+  EXPECT_EQ(r.scenario.seed, 42u);
+  ASSERT_EQ(r.scenario.segments.size(), 2u);
+  EXPECT_EQ(r.scenario.segments[1].condition, "white-walls");
+  EXPECT_EQ(r.scenario.segments[1].end, 900);
+  EXPECT_EQ(r.sensors.gyro_noise_density, 1.7e-4);
+  EXPECT_EQ(r.sensors.lidar_model, "vlp16");
+  EXPECT_NE(reader->describe().find("hand-made"), std::string::npos);
+}
+
+TEST(SimDataset, LoadOptionsDropStreams) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  DatasetOptions o;
+  o.load_imu = o.load_images = false;
+  auto reader = openSimDataset(dir.string(), o);
+  std::size_t scans = 0, others = 0;
+  while (auto m = reader->next()) (std::holds_alternative<LidarScan>(*m) ? scans : others)++;
+  EXPECT_EQ(scans, 3u);
+  EXPECT_EQ(others, 0u);
+}
+
+TEST(SimDatasetWriter, RefusesAnExistingFolderUnlessOverwriting) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  EXPECT_THROW(SimDatasetWriter(dir.string(), description()), std::invalid_argument);
+  SimWriterOptions o;
+  o.overwrite = true;
+  SimDatasetWriter w(dir.string(), description(), o);
+  w.add(imuAt(7));
+  w.finish(groundTruth());
+  EXPECT_EQ(readAll(dir).size(), 1u);  // replaced
+}
+
+TEST(SimDatasetWriter, InterruptedWriteLeavesNoDatasetBehind) {
+  TempDir tmp;
+  const fs::path dir = tmp / "ds";
+  {
+    SimDatasetWriter w(dir.string(), description());
+    w.add(imuAt(0));
+    w.add(frameAt(3));
+    EXPECT_TRUE(fs::exists(w.partialDir()));
+    EXPECT_FALSE(fs::exists(dir));
+  }  // destroyed without finish()
+  EXPECT_FALSE(fs::exists(dir));
+  EXPECT_FALSE(fs::exists(tmp / "ds.partial"));
+}
+
+TEST(SimDatasetWriter, RejectsTimeGoingBackwardsAndBadImages) {
+  TempDir tmp;
+  SimDatasetWriter w((tmp / "ds").string(), description());
+  w.add(imuAt(10));
+  EXPECT_THROW(w.add(imuAt(10)), std::invalid_argument);
+  w.add(scanAt(10, 2));
+  EXPECT_THROW(w.add(scanAt(5, 2)), std::invalid_argument);
+  CameraFrame f = frameAt(20);
+  f.image.width = 4;
+  EXPECT_THROW(w.add(std::move(f)), std::invalid_argument);
+  LidarScan s = scanAt(30, 2);
+  s.points[1].ring = 16;  // vlp16 has rings 0..15
+  EXPECT_THROW(w.add(std::move(s)), std::invalid_argument);
+}
+
+// ---- damaged datasets: one error each, naming file and record ------------------------------------------------
+
+TEST(SimDatasetReader, MissingCalibrationFileIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  fs::remove(dir / "calibration.yaml");
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"calibration.yaml", "not found"});
+}
+
+TEST(SimDatasetReader, MissingCalibrationKeyIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "calibration.yaml", "  T_imu_cam:", "  T_imu_camera:");
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"calibration.yaml", "calibration.T_imu_cam", "missing"});
+  const fs::path dir2 = tmp / "ds2";
+  fs::copy(dir, dir2, fs::copy_options::recursive);
+  replaceInFile(dir2 / "calibration.yaml", "T_imu_camera:", "T_imu_cam:");
+  replaceInFile(dir2 / "calibration.yaml", "    rings: 16\n", "");
+  expectIoError([&] { openSimDataset(dir2.string(), {}); }, {"sensors.lidar.rings", "missing"});
+}
+
+TEST(SimDatasetReader, ScanFileSizeNotAMultipleOfTheRecordIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  std::ofstream(dir / "lidar" / "000001.bin", std::ios::binary | std::ios::app) << "xyz";
+  expectIoError([&] { readAll(dir); }, {"000001.bin", "not a multiple of the 24-byte"});
+}
+
+TEST(SimDatasetReader, NanPointIsNamedByFileAndPoint) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  std::fstream f(dir / "lidar" / "000002.bin", std::ios::binary | std::ios::in | std::ios::out);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  f.seekp(3 * 24 + 4);  // point 3, y
+  f.write(reinterpret_cast<const char*>(&nan), 4);
+  f.close();
+  expectIoError([&] { readAll(dir); }, {"000002.bin", "point 3", "non-finite"});
+}
+
+TEST(SimDatasetReader, NanInImuCsvIsNamedByLine) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  // The sample at t = 20 ns: its first value (omega x) becomes "nan".
+  std::string text = readTextFile((dir / "imu.csv").string());
+  const std::size_t start = text.find("\n20,") + 4, end = text.find(',', start);
+  text.replace(start, end - start, "nan");
+  test::writeText(dir / "imu.csv", text);
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"imu.csv", "line 4"});
+}
+
+TEST(SimDatasetReader, ImuTimeGoingBackwardsIsNamedByLine) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "imu.csv", "\n30,", "\n15,");
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"imu.csv", "line 5", "backwards"});
+}
+
+TEST(SimDatasetReader, LidarTimeGoingBackwardsIsNamedByLine) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "lidar" / "timestamps.csv", "2,200,", "2,50,");
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"timestamps.csv", "line 4", "backwards"});
+}
+
+TEST(SimDatasetReader, MissingScanFileIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  fs::remove(dir / "lidar" / "000001.bin");
+  expectIoError([&] { readAll(dir); }, {"000001.bin", "lidar/timestamps.csv line 3", "not found"});
+}
+
+TEST(SimDatasetReader, MissingImageFileIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  fs::remove(dir / "camera" / "000000.png");
+  expectIoError([&] { readAll(dir); }, {"000000.png", "camera/timestamps.csv line 2", "not found"});
+}
+
+TEST(SimDatasetReader, MissingImuFileIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  fs::remove(dir / "imu.csv");
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"imu.csv", "not found"});
+}
+
+TEST(SimDatasetReader, RingBeyondTheLidarsRingsIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "calibration.yaml", "rings: 16", "rings: 4");
+  expectIoError([&] { readAll(dir); }, {"000000.bin", "point 4", "ring 4 >= 4"});
+}
+
+// ---- the `sim:` config section --------------------------------------------------------------------------------
+
+TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
+  TempDir tmp;
+  test::writeText(tmp / "a.yaml", "dataset:\n  load_lidar: true\nsim:\n  lidar_model: hdl64\n  camera_rate_hz: 20\n"
+                                  "  camera_color: true\n  camera_time_offset: -0.002\n");
+  const SimConfigSettings s = loadSimConfigSettings((tmp / "a.yaml").string());
+  EXPECT_EQ(s.lidar_model, "hdl64");
+  EXPECT_EQ(s.camera_rate_hz, 20.0);
+  EXPECT_EQ(s.camera_color, true);
+  EXPECT_EQ(s.camera_time_offset_s, -0.002);
+  EXPECT_FALSE(s.imu_rate_hz.has_value());
+  test::writeText(tmp / "b.yaml", "sim:\n  lidar_modle: vlp32\n");
+  expectIoError([&] { loadSimConfigSettings((tmp / "b.yaml").string()); }, {"b.yaml", "line 2", "sim.lidar_modle"});
+  test::writeText(tmp / "c.yaml", "sim:\n  lidar_model: vlp17\n");
+  expectIoError([&] { loadSimConfigSettings((tmp / "c.yaml").string()); }, {"c.yaml", "vlp17"});
+}
+
+TEST(SimConfigSettings, FarmSimConfigIsAValidPlatformAndSimConfig) {
+  const std::string path = std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml";
+  EXPECT_NO_THROW(loadDatasetOptions(path));
+  const SimConfigSettings s = loadSimConfigSettings(path);
+  EXPECT_EQ(s.lidar_model, "vlp16");
+  EXPECT_EQ(s.camera_rate_hz, 15.0);
+}
+
+}  // namespace
+}  // namespace drover::io
