@@ -101,20 +101,6 @@ void printResult(const std::string& title, std::size_t pairs, std::size_t max_pa
              statisticsTable(s));
 }
 
-// Errors at the estimate poses est_aligned[k] for k in `at`; the reference path for context.
-PlotData plotData(const std::string& title, const char* unit, const std::vector<Time>& times,
-                  const std::vector<double>& errors, const Trajectory& est_aligned, const std::vector<std::size_t>& at,
-                  const Trajectory& ref, const std::vector<std::size_t>& ref_index) {
-  PlotData d;
-  d.title = title;
-  d.unit = unit;
-  d.times = times;
-  d.errors = errors;
-  for (const std::size_t k : at) d.est_at_errors.push_back(est_aligned[k].T_world_body.translation());
-  for (const std::size_t i : ref_index) d.ref_path.push_back(ref[i].T_world_body.translation());
-  return d;
-}
-
 void runApe(const CommonOptions& o) {
   Trajectory ref, est;
   loadBoth(o, ref, est);

@@ -8,5 +8,6 @@ namespace drover::cli {
 void registerEval(CLI::App& app);
 void registerInfo(CLI::App& app);
 void registerSim(CLI::App& app);
+void registerRun(CLI::App& app);
 
 }  // namespace drover::cli

@@ -184,6 +184,20 @@ int runScript(const std::string& python, const std::string& script, const fs::pa
 
 }  // namespace
 
+// Errors at the estimate poses est_aligned[k] for k in `at`; the reference path for context.
+PlotData plotData(const std::string& title, const char* unit, const std::vector<Time>& times,
+                  const std::vector<double>& errors, const Trajectory& est_aligned, const std::vector<std::size_t>& at,
+                  const Trajectory& ref, const std::vector<std::size_t>& ref_index) {
+  PlotData d;
+  d.title = title;
+  d.unit = unit;
+  d.times = times;
+  d.errors = errors;
+  for (const std::size_t k : at) d.est_at_errors.push_back(est_aligned[k].T_world_body.translation());
+  for (const std::size_t i : ref_index) d.ref_path.push_back(ref[i].T_world_body.translation());
+  return d;
+}
+
 bool writePlot(const PlotData& data, const std::string& png) {
   // DROVER_PYTHON overrides the interpreter (tests use it to simulate a machine without python3).
   const char* env = std::getenv("DROVER_PYTHON");

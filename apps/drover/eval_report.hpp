@@ -35,6 +35,11 @@ struct PlotData {
   std::vector<Eigen::Vector3d> ref_path;       // the matched reference, for context
 };
 
+// Errors at the estimate poses est_aligned[k] for k in `at`; the reference path ref[ref_index] for context.
+PlotData plotData(const std::string& title, const char* unit, const std::vector<Time>& times,
+                  const std::vector<double>& errors, const Trajectory& est_aligned, const std::vector<std::size_t>& at,
+                  const Trajectory& ref, const std::vector<std::size_t>& ref_index);
+
 // Runs the plot script to write `png`. Never throws for a missing python3/matplotlib or a failing script:
 // returns false after logging one line saying the plot was skipped and why.
 bool writePlot(const PlotData& data, const std::string& png);

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   drover::cli::registerEval(app);
   drover::cli::registerInfo(app);
   drover::cli::registerSim(app);
+  drover::cli::registerRun(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -1,0 +1,184 @@
+#include "apps/drover/run_output.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <numeric>
+
+#include "apps/drover/eval_report.hpp"
+#include "eval/ape.hpp"
+#include "io/cloud_io.hpp"
+#include "io/kitti_common.hpp"
+#include "io/trajectory_io.hpp"
+
+namespace drover::cli {
+namespace {
+namespace fs = std::filesystem;
+
+constexpr float kMapLeaf = 0.2f;  // [m] voxel leaf of the exported map
+
+std::string inRun(const RunContext& c, const char* name) { return (fs::path(c.out) / name).string(); }
+
+// T_world_lidar -> T_world_body for the ground truth's body frame ("imu": T_world_imu = T_world_lidar T_lidar_imu).
+Trajectory inBodyFrame(const Trajectory& lidar, const RunContext& c) {
+  if (c.ground_truth.body_frame != "imu") return lidar;
+  const Eigen::Isometry3d T_lidar_imu = c.calibration.T_imu_lidar.inverse();
+  Trajectory out = lidar;
+  for (auto& p : out) p.T_world_body = p.T_world_body * T_lidar_imu;
+  return out;
+}
+
+// KITTI devkit frame: T_cam0(0)_cam0(i) = Tr T_lidar0_lidar_i Tr^-1 with Tr = T_cam0_lidar from calib.txt.
+void writeKittiTrajectory(const RunContext& c, const Trajectory& lidar) {
+  if (c.format != "kitti" || lidar.empty()) return;
+  const io::KittiCalibFile calib((fs::path(c.dataset) / "calib.txt").string());
+  const Eigen::Isometry3d Tr = calib.rigid34("Tr");
+  const Eigen::Isometry3d T_lidar0_world = lidar.front().T_world_body.inverse();
+  Trajectory cam = lidar;
+  for (auto& p : cam) p.T_world_body = Tr * (T_lidar0_world * p.T_world_body) * Tr.inverse();
+  io::writeKitti(inRun(c, "trajectory_kitti.txt"), cam);
+}
+
+struct StageSummary {
+  double mean = 0, p95 = 0, max = 0;
+};
+
+StageSummary summarize(std::vector<double> v) {
+  StageSummary s;
+  if (v.empty()) return s;
+  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  std::sort(v.begin(), v.end());
+  s.p95 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(v.size())))];
+  s.max = v.back();
+  return s;
+}
+
+Json timingsJson(const RunRecord& r) {
+  Json j;
+  const std::pair<const char*, double pipeline::StageTimes::*> stages[] = {
+      {"preprocess", &pipeline::StageTimes::preprocess}, {"deskew", &pipeline::StageTimes::deskew},
+      {"features", &pipeline::StageTimes::features},     {"map", &pipeline::StageTimes::map},
+      {"match", &pipeline::StageTimes::match},           {"smoother", &pipeline::StageTimes::smoother},
+      {"total", &pipeline::StageTimes::total}};
+  for (const auto& [name, member] : stages) {
+    std::vector<double> v;
+    for (const auto& s : r.scans) v.push_back(s.ms.*member);
+    const StageSummary s = summarize(std::move(v));
+    j[name] = {{"mean_ms", s.mean}, {"p95_ms", s.p95}, {"max_ms", s.max}};
+  }
+  return j;
+}
+
+Json statsJson(const pipeline::OdometryStats& s) {
+  Json j;
+  j["scans_in"] = s.scans_in;
+  j["scans_processed"] = s.scans_processed;
+  j["scans_skipped_empty"] = s.scans_skipped_empty;
+  j["scans_skipped_time"] = s.scans_skipped_time;
+  j["points_dropped"] = s.points_dropped;
+  j["keyframes"] = s.keyframes;
+  j["degenerate_scans"] = s.degenerate_scans;
+  j["not_converged"] = s.not_converged;
+  j["smoother_resets"] = s.smoother_resets;
+  j["imu_scans"] = s.imu_scans;
+  j["imu_initialized"] = s.imu_initialized;
+  j["imu_init"] = s.imu_init;
+  j["imu"] = {{"accepted", s.imu.accepted},
+              {"gaps", s.imu.gaps},
+              {"largest_gap_s", s.imu.largest_gap_s},
+              {"dropped_nonfinite", s.imu.dropped_nonfinite},
+              {"dropped_out_of_order", s.imu.dropped_out_of_order},
+              {"dropped_spike", s.imu.dropped_spike}};
+  Json deg = Json::array(), resets = Json::array();
+  for (Time t : s.degenerate_times) deg.push_back(toSeconds(t));
+  for (Time t : s.reset_times) resets.push_back(toSeconds(t));
+  j["degenerate_times_s"] = deg;
+  j["reset_times_s"] = resets;
+  return j;
+}
+
+// One compact record per sweep, for diagnosing a run.
+Json scansJson(const RunRecord& r) {
+  Json a = Json::array();
+  for (const pipeline::ScanOutcome& s : r.scans)
+    a.push_back({{"t", toSeconds(s.t)},
+                 {"status", s.match_status},
+                 {"iterations", s.iterations},
+                 {"fitness_m", s.fitness},
+                 {"edge_inliers", s.edge_inliers},
+                 {"plane_inliers", s.plane_inliers},
+                 {"points", s.points},
+                 {"edges", s.edges},
+                 {"planes", s.planes},
+                 {"keyframe", s.keyframe},
+                 {"degenerate", s.degenerate_count},
+                 {"imu", s.imu_used},
+                 {"reset", s.reset},
+                 {"total_ms", s.ms.total}});
+  return a;
+}
+
+// APE of the translation with SE(3) alignment (and the rotation angle), printed as evo prints it.
+Json evaluate(const RunContext& c, const Trajectory& est) {
+  if (c.ground_truth.poses.empty() || est.size() < 3) return nullptr;
+  eval::ApeOptions options;
+  options.alignment = eval::Alignment::kSe3;
+  options.association.max_diff = 10'000'000;  // 10 ms, evo's default
+  Json j;
+  try {
+    const eval::ApeResult r = eval::computeApe(c.ground_truth.poses, est, options);
+    fmt::print("{}\n\n{}\n", apeTitle(r), statisticsTable(r.stats));
+    j = statisticsJson(r.stats);
+    j["pairs"] = r.pairs;
+    options.relation = eval::PoseRelation::kAngleDeg;
+    j["rotation_deg"] = statisticsJson(eval::computeApe(c.ground_truth.poses, est, options).stats);
+    io::writeFileAtomically(inRun(c, "ape.json"), j.dump(2) + "\n");
+    std::vector<std::size_t> all(r.pairs);
+    std::iota(all.begin(), all.end(), 0);
+    writePlot(plotData(apeTitle(r), eval::relationUnit(r.relation), r.times, r.errors, r.est_aligned, all,
+                       c.ground_truth.poses, r.association.first),
+              inRun(c, "ape.png"));
+  } catch (const std::invalid_argument& e) {
+    spdlog::warn("APE not computed: {}", e.what());
+    j = {{"error", e.what()}};
+  }
+  return j;
+}
+
+}  // namespace
+
+void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r) {
+  const Trajectory est = inBodyFrame(odometry.trajectory(), c);
+  if (!est.empty()) {
+    io::writeTum(inRun(c, "trajectory.tum"), est);
+    io::writeTum(inRun(c, "keyframes.tum"), inBodyFrame(odometry.keyframeTrajectory(), c));
+  }
+  writeKittiTrajectory(c, odometry.trajectory());
+  const lidar::PointCloud map = odometry.mapCloud(kMapLeaf);
+  io::writePcdBinary(inRun(c, "map.pcd"), map);
+  io::writePlyBinary(inRun(c, "map.ply"), map);
+
+  const pipeline::OdometryStats& s = odometry.stats();
+  Json report;
+  report["dataset"] = c.dataset;
+  report["format"] = c.format;
+  report["config"] = c.config;
+  report["mode"] = odometry.config().use_imu ? "lidar+imu" : "lidar";
+  report["body_frame"] = c.ground_truth.body_frame.empty() ? "lidar" : c.ground_truth.body_frame;
+  report["wall_s"] = r.wall_s;
+  report["data_s"] = r.data_s;
+  report["real_time_factor"] = r.wall_s > 0 ? r.data_s / r.wall_s : 0.0;
+  report["map_points"] = map.size();
+  report["counts"] = statsJson(s);
+  report["timings"] = timingsJson(r);
+  report["ape"] = evaluate(c, est);
+  report["scans"] = scansJson(r);
+  io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
+  spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",
+               s.scans_processed, s.keyframes, s.degenerate_scans, s.smoother_resets, r.wall_s,
+               r.wall_s > 0 ? r.data_s / r.wall_s : 0.0, c.out);
+}
+
+}  // namespace drover::cli

@@ -1,0 +1,34 @@
+#pragma once
+// What `drover run` writes into its run folder (names that scripts rely on):
+//   trajectory.tum        one pose per sweep, T_world_body with body = the ground truth's body frame (the IMU for
+//                         simulated and IMU datasets, the lidar for KITTI odometry), TUM format
+//   trajectory_kitti.txt  KITTI odometry only: one line per sweep, camera-0 frame, first pose identity
+//   keyframes.tum         the keyframes' poses, same frame as trajectory.tum
+//   map.pcd, map.ply      the keyframes' clouds in the world frame (binary)
+//   report.json           counts, per-stage timings, degenerate sweeps, resets, and the APE when there is ground truth
+//   ape.json, ape.png     APE (translation, SE(3)-aligned) against the ground truth, when there is one
+#include <string>
+#include <vector>
+
+#include "io/reader.hpp"
+#include "pipeline/lidar_odometry.hpp"
+
+namespace drover::cli {
+
+struct RunContext {
+  std::string dataset, format, config, out;
+  const Calibration& calibration;
+  const io::GroundTruth& ground_truth;
+};
+
+struct RunRecord {
+  std::vector<pipeline::ScanOutcome> scans;
+  double wall_s = 0;  // [s] wall time of the odometry loop (reading included)
+  double data_s = 0;  // [s] time spanned by the processed sweeps
+};
+
+// Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be
+// written.
+void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, const RunRecord& record);
+
+}  // namespace drover::cli

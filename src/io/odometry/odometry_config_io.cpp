@@ -1,0 +1,179 @@
+#include "io/odometry/odometry_config_io.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <filesystem>
+
+#include "io/config.hpp"
+#include "io/error.hpp"
+#include "io/text_parsing.hpp"
+#include "io/yaml_section.hpp"
+
+namespace drover::io {
+namespace {
+
+// Enumerations travel as strings through the binder and are checked here.
+struct EnumStrings {
+  std::string spin = "ccw", ring_source, kernel = "lio-sam";
+};
+
+void bindLayout(YamlSection& s, lidar::ScanLayoutConfig& c, EnumStrings& e) {
+  s.bind("n_rings", c.n_rings)
+      .bind("vertical_fov_min_deg", c.vertical_fov_min_deg)
+      .bind("vertical_fov_max_deg", c.vertical_fov_max_deg)
+      .bind("columns", c.columns)
+      .bind("scan_period", c.scan_period)
+      .bind("spin", e.spin)
+      .bind("ring_source", e.ring_source)
+      .bind("order_top_down", c.order_top_down)
+      .bind("seam_tolerance_deg", c.seam_tolerance_deg)
+      .bind("min_range", c.min_range)
+      .bind("max_range", c.max_range);
+}
+
+// Float fields of the feature extractor go through doubles.
+struct FeatureFloats {
+  double edge_threshold, surf_threshold, occlusion_depth_gap, parallel_ratio, edge_leaf, surf_leaf, full_leaf;
+};
+
+void bindFeatures(YamlSection& s, lidar::FeatureExtractorConfig& c, FeatureFloats& f) {
+  s.bind("columns", c.columns)
+      .bind("min_range", c.min_range)
+      .bind("max_range", c.max_range)
+      .bind("half_window", c.half_window)
+      .bind("edge_threshold", f.edge_threshold)
+      .bind("surf_threshold", f.surf_threshold)
+      .bind("sub_regions", c.sub_regions)
+      .bind("max_edges_per_region", c.max_edges_per_region)
+      .bind("suppression_radius", c.suppression_radius)
+      .bind("max_column_gap", c.max_column_gap)
+      .bind("occlusion_depth_gap", f.occlusion_depth_gap)
+      .bind("parallel_ratio", f.parallel_ratio)
+      .bind("edge_leaf", f.edge_leaf)
+      .bind("surf_leaf", f.surf_leaf)
+      .bind("full_leaf", f.full_leaf);
+}
+
+void bindLocalMap(YamlSection& s, lidar::LocalMapConfig& c) {
+  s.bind("surrounding_radius", c.surrounding_radius)
+      .bind("keyframe_density", c.keyframe_density)
+      .bind("recent_window", c.recent_window)
+      .bind("recent_count", c.recent_count)
+      .bind("edge_leaf", c.edge_leaf)
+      .bind("plane_leaf", c.plane_leaf)
+      .bind("full_leaf", c.full_leaf)
+      .bind("cache_capacity", c.cache_capacity);
+}
+
+void bindMatcher(YamlSection& s, lidar::ScanMatcherConfig& c, EnumStrings& e) {
+  s.bind("max_iterations", c.max_iterations)
+      .bind("convergence_translation", c.convergence_translation)
+      .bind("convergence_rotation", c.convergence_rotation)
+      .bind("neighbors", c.neighbors)
+      .bind("max_neighbor_distance", c.max_neighbor_distance)
+      .bind("edge_eigen_ratio", c.edge_eigen_ratio)
+      .bind("plane_tolerance", c.plane_tolerance)
+      .bind("kernel", e.kernel)
+      .bind("min_weight", c.min_weight)
+      .bind("huber_delta", c.huber_delta)
+      .bind("degeneracy_threshold", c.degeneracy_threshold)
+      .bind("min_edge_features", c.min_edge_features)
+      .bind("min_plane_features", c.min_plane_features)
+      .bind("min_correspondences", c.min_correspondences);
+}
+
+void bindImu(YamlSection& s, imu::PreintegrationConfig& c) {
+  s.bind("gyro_noise_density", c.gyro_noise_density)
+      .bind("acc_noise_density", c.acc_noise_density)
+      .bind("gyro_bias_random_walk", c.gyro_bias_random_walk)
+      .bind("acc_bias_random_walk", c.acc_bias_random_walk)
+      .bind("integration_sigma", c.integration_sigma)
+      .bind("gravity", c.gravity);
+}
+
+void bindSmoother(YamlSection& s, backend::FixedLagSmootherConfig& c) {
+  s.bind("window", c.window)
+      .bind("prior_sigma_position", c.prior_sigma_position)
+      .bind("prior_sigma_rotation", c.prior_sigma_rotation)
+      .bind("prior_sigma_velocity", c.prior_sigma_velocity)
+      .bind("prior_sigma_gyro_bias", c.prior_sigma_gyro_bias)
+      .bind("prior_sigma_acc_bias", c.prior_sigma_acc_bias)
+      .bind("max_iterations", c.max_iterations)
+      .bind("max_velocity", c.max_velocity)
+      .bind("max_bias", c.max_bias);
+}
+
+void applyEnums(const EnumStrings& e, pipeline::OdometryConfig& c, const std::string& file) {
+  if (e.spin == "ccw") {
+    c.layout.spin = lidar::SpinDirection::kCounterClockwise;
+  } else if (e.spin == "cw") {
+    c.layout.spin = lidar::SpinDirection::kClockwise;
+  } else {
+    fail(file, "key 'odometry.layout.spin'", "expected ccw or cw, got '" + e.spin + "'");
+  }
+  if (e.ring_source == "elevation") {
+    c.layout.ring_source = lidar::RingSource::kElevation;
+  } else if (e.ring_source == "order") {
+    c.layout.ring_source = lidar::RingSource::kOrder;
+  } else if (!e.ring_source.empty()) {
+    fail(file, "key 'odometry.layout.ring_source'", "expected elevation or order, got '" + e.ring_source + "'");
+  }
+  if (e.kernel == "lio-sam") {
+    c.matcher.kernel = lidar::RobustKernel::kLioSam;
+  } else if (e.kernel == "huber") {
+    c.matcher.kernel = lidar::RobustKernel::kHuber;
+  } else {
+    fail(file, "key 'odometry.matcher.kernel'", "expected lio-sam or huber, got '" + e.kernel + "'");
+  }
+}
+
+}  // namespace
+
+pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
+  if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
+  YAML::Node root;
+  try {
+    root = YAML::Load(readYamlText(yaml_path));
+  } catch (const YAML::Exception& e) {
+    fail(yaml_path, lineRecord(static_cast<std::size_t>(e.mark.line + 1)), "invalid YAML: " + e.msg);
+  }
+  pipeline::OdometryConfig c;
+  if (root.IsNull()) return c;
+  if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
+  EnumStrings e;
+  const lidar::FeatureExtractorConfig& fc = c.features;
+  FeatureFloats f{fc.edge_threshold, fc.surf_threshold, fc.occlusion_depth_gap, fc.parallel_ratio,
+                  fc.edge_leaf,      fc.surf_leaf,      fc.full_leaf};
+  YamlSection top(yaml_path, "odometry");
+  top.bind("use_imu", c.use_imu)
+      .bind("deskew", c.deskew)
+      .bind("min_points", c.min_points)
+      .bind("imu_wait", c.imu_wait)
+      .bind("lidar_sigma_position", c.lidar_sigma_position)
+      .bind("lidar_sigma_rotation", c.lidar_sigma_rotation)
+      .bind("degenerate_sigma", c.degenerate_sigma)
+      .nested("layout", [&](YamlSection& s) { bindLayout(s, c.layout, e); })
+      .nested("features", [&](YamlSection& s) { bindFeatures(s, c.features, f); })
+      .nested("local_map", [&](YamlSection& s) { bindLocalMap(s, c.local_map); })
+      .nested("matcher", [&](YamlSection& s) { bindMatcher(s, c.matcher, e); })
+      .nested("keyframes", [&](YamlSection& s) {
+        s.bind("distance", c.keyframes.distance).bind("angle", c.keyframes.angle);
+      })
+      .nested("imu", [&](YamlSection& s) { bindImu(s, c.preintegration); })
+      .nested("smoother", [&](YamlSection& s) { bindSmoother(s, c.smoother); });
+  top.apply(root["odometry"]);
+  applyEnums(e, c, yaml_path);
+  c.features.edge_threshold = static_cast<float>(f.edge_threshold);
+  c.features.surf_threshold = static_cast<float>(f.surf_threshold);
+  c.features.occlusion_depth_gap = static_cast<float>(f.occlusion_depth_gap);
+  c.features.parallel_ratio = static_cast<float>(f.parallel_ratio);
+  c.features.edge_leaf = static_cast<float>(f.edge_leaf);
+  c.features.surf_leaf = static_cast<float>(f.surf_leaf);
+  c.features.full_leaf = static_cast<float>(f.full_leaf);
+  // The IMU noise model is one: the propagator and the initializer use the same gravity.
+  c.propagator.gravity = c.initializer.gravity = c.preintegration.gravity;
+  if (std::string err = c.validate(); !err.empty()) fail(yaml_path, "section 'odometry'", err);
+  return c;
+}
+
+}  // namespace drover::io

@@ -1,0 +1,27 @@
+#pragma once
+// The `odometry:` section of a platform config (config/*.yaml) -> pipeline::OdometryConfig. Every key is optional
+// (left out = the default in the component's Config, whose header gives its unit); an unknown key or a bad value is
+// an IoError naming the file, the line and the dotted key. Sections and keys:
+//   odometry: use_imu, deskew, min_points, imu_wait [s], lidar_sigma_position [m], lidar_sigma_rotation [rad],
+//             degenerate_sigma
+//     layout:       n_rings, vertical_fov_min_deg, vertical_fov_max_deg, columns, scan_period [s],
+//                   spin (ccw | cw), ring_source (elevation | order), order_top_down, min_range, max_range [m]
+//     features:     edge_threshold, surf_threshold (LIO-SAM edgeThreshold/surfThreshold), surf_leaf, edge_leaf,
+//                   full_leaf [m], sub_regions, max_edges_per_region, ... (lidar/feature_extractor.hpp)
+//     local_map:    surrounding_radius [m], keyframe_density [m], recent_window [s], edge_leaf, plane_leaf [m], ...
+//     matcher:      max_iterations, degeneracy_threshold, kernel (lio-sam | huber), ...
+//     keyframes:    distance [m], angle [rad]
+//     imu:          gyro_noise_density, acc_noise_density, gyro_bias_random_walk, acc_bias_random_walk, gravity
+//     smoother:     window, max_iterations, ...
+// Lives in its own library (drover_io_odometry) so that the readers do not depend on the odometry modules.
+#include <string>
+
+#include "pipeline/odometry_config.hpp"
+
+namespace drover::io {
+
+// Throws IoError (file, line, key) for a missing file, invalid YAML, unknown key or bad value, and when the result
+// fails OdometryConfig::validate() (naming the file).
+pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path);
+
+}  // namespace drover::io

@@ -1,0 +1,83 @@
+#include "io/yaml_section.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <limits>
+
+#include "io/error.hpp"
+#include "io/text_parsing.hpp"
+
+namespace drover::io {
+namespace {
+
+std::string record(const YAML::Node& n, const std::string& dotted) {
+  const int line = n.Mark().line;
+  return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key '" + dotted +
+         "'";
+}
+
+std::string scalarOf(const YAML::Node& n, const std::string& file, const std::string& rec) {
+  if (!n.IsScalar()) fail(file, rec, "expected a single value");
+  return n.Scalar();
+}
+
+}  // namespace
+
+YamlSection::YamlSection(std::string file, std::string prefix) : file_(std::move(file)), prefix_(std::move(prefix)) {}
+
+YamlSection& YamlSection::bind(const std::string& key, double& value) {
+  setters_[key] = [this, &value](const YAML::Node& n, const std::string& rec) {
+    value = parseDouble(scalarOf(n, file_, rec), file_, rec);
+  };
+  return *this;
+}
+
+YamlSection& YamlSection::bind(const std::string& key, int& value) {
+  setters_[key] = [this, &value](const YAML::Node& n, const std::string& rec) {
+    const std::int64_t v = parseInt64(scalarOf(n, file_, rec), file_, rec);
+    if (v < std::numeric_limits<int>::min() || v > std::numeric_limits<int>::max()) fail(file_, rec, "out of range");
+    value = static_cast<int>(v);
+  };
+  return *this;
+}
+
+YamlSection& YamlSection::bind(const std::string& key, bool& value) {
+  setters_[key] = [this, &value](const YAML::Node& n, const std::string& rec) {
+    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, value)) fail(file_, rec, "expected true or false");
+  };
+  return *this;
+}
+
+YamlSection& YamlSection::bind(const std::string& key, std::string& value) {
+  setters_[key] = [this, &value](const YAML::Node& n, const std::string& rec) { value = scalarOf(n, file_, rec); };
+  return *this;
+}
+
+YamlSection& YamlSection::nested(const std::string& key, std::function<void(YamlSection&)> read) {
+  nested_[key] = std::move(read);
+  return *this;
+}
+
+void YamlSection::apply(const YAML::Node& node) const {
+  if (!node || node.IsNull()) return;
+  if (!node.IsMap()) fail(file_, record(node, prefix_), "expected a map of settings");
+  for (const auto& kv : node) {
+    const std::string key = kv.first.Scalar();
+    const std::string dotted = prefix_ + "." + key;
+    if (auto s = setters_.find(key); s != setters_.end()) {
+      s->second(kv.second, record(kv.first, dotted));
+    } else if (auto n = nested_.find(key); n != nested_.end()) {
+      YamlSection child(file_, dotted);
+      n->second(child);
+      child.apply(kv.second);
+    } else {
+      std::string known;
+      for (const auto& [k, _] : setters_) known += (known.empty() ? "" : ", ") + k;
+      for (const auto& [k, _] : nested_) known += (known.empty() ? "" : ", ") + k;
+      fail(file_, record(kv.first, dotted), "unknown key (expected one of: " + known + ")");
+    }
+  }
+}
+
+}  // namespace drover::io

@@ -1,0 +1,40 @@
+#pragma once
+// Reads one YAML section of a platform config into typed fields that the caller binds by name, so that every
+// module's Config can be filled from a file without the module knowing about YAML. An unknown key, a value of the
+// wrong type or a non-finite number is an IoError naming the file, the line and the dotted key
+// ("odometry.matcher.max_iterations"): a typo must never fall back to a default silently.
+#include <functional>
+#include <map>
+#include <string>
+
+namespace YAML {
+class Node;
+}
+
+namespace drover::io {
+
+class YamlSection {
+ public:
+  // `prefix` names the section in messages, e.g. "odometry.matcher".
+  YamlSection(std::string file, std::string prefix);
+  YamlSection& bind(const std::string& key, double& value);
+  YamlSection& bind(const std::string& key, int& value);
+  YamlSection& bind(const std::string& key, bool& value);
+  YamlSection& bind(const std::string& key, std::string& value);
+  // A nested section, read by `read` (which binds its own keys on the YamlSection it is given).
+  YamlSection& nested(const std::string& key, std::function<void(YamlSection&)> read);
+
+  // Applies a map node: every key must have been bound. A null node changes nothing.
+  void apply(const YAML::Node& node) const;
+
+  const std::string& file() const { return file_; }
+  const std::string& prefix() const { return prefix_; }
+
+ private:
+  using Setter = std::function<void(const YAML::Node&, const std::string& record)>;
+  std::string file_, prefix_;
+  std::map<std::string, Setter> setters_;
+  std::map<std::string, std::function<void(YamlSection&)>> nested_;
+};
+
+}  // namespace drover::io

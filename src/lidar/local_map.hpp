@@ -1,0 +1,109 @@
+#pragma once
+// The keyframe map that scan matching runs against (LIO-SAM mapOptimization's extractSurroundingKeyFrames /
+// extractCloud, without its global state). Every keyframe keeps its features once, in its own lidar frame,
+// downsampled with the map's leaf sizes; build() assembles the edges and planes of the keyframes near a point
+// (plus the most recent ones) into the world frame, downsamples them again and indexes them with two k-d trees.
+// World-frame copies of keyframe clouds are cached per keyframe so consecutive builds transform only keyframes
+// that entered the local map or whose pose changed (updatePose, e.g. after a loop closure).
+//
+// Not thread-safe for mutation: addKeyframe/updatePose/build must not run concurrently with anything else. The
+// const queries (nearestEdges/nearestPlanes and the accessors) may run from many threads at once. A moved-from
+// LocalMap may only be assigned to or destroyed.
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lidar/feature_set.hpp"
+#include "types/time.hpp"
+
+namespace drover::lidar {
+
+struct LocalMapConfig {
+  double surrounding_radius = 50.0;  // [m] keyframes whose position is this close to the centre (LIO-SAM's
+                                     // surroundingKeyframeSearchRadius)
+  double keyframe_density = 2.0;     // [m] among the surrounding keyframes keep the newest one per cube of this
+                                     // side (surroundingKeyframeDensity); 0 keeps all
+  double recent_window = 10.0;       // [s] keyframes this close in time to the newest one are always included,
+                                     // however far they are (LIO-SAM's 10 s); 0 disables
+  int recent_count = 0;              // [-] the newest N keyframes are always included as well; 0 disables
+  double edge_leaf = 0.2;            // [m] voxel leaf of keyframe and local-map edges (mappingCornerLeafSize)
+  double plane_leaf = 0.4;           // [m] voxel leaf of keyframe and local-map planes (mappingSurfLeafSize)
+  double full_leaf = 0.0;            // [m] voxel leaf applied to a keyframe's full cloud when stored; 0 keeps it
+  int cache_capacity = 1000;         // [keyframes] world-frame clouds cached at most (LIO-SAM clears at 1000);
+                                     // the keyframes of the current local map are never evicted
+  // Empty when valid: every value finite, radius > 0, the others >= 0, edge/plane leaves > 0, capacity >= 1.
+  std::string validate() const;
+};
+
+// One keyframe as stored: features in its lidar frame (downsampled), its pose and the sweep time.
+struct Keyframe {
+  std::size_t index = 0;                                            // position in the map, 0..size()-1
+  Time t = 0;                                                       // [ns] the FeatureSet's sweep start
+  Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();  // maps keyframe lidar points to the world
+  FeatureSet features;                                              // lidar frame
+};
+
+// What build() did.
+struct LocalMapBuild {
+  std::vector<std::size_t> keyframes;  // indices assembled, ascending
+  std::size_t edge_points = 0;         // in the assembled (downsampled) edge cloud
+  std::size_t plane_points = 0;        // in the assembled (downsampled) plane cloud
+  std::size_t transformed = 0;         // keyframes transformed into the world in this build (cache misses)
+  bool reused = false;                 // true when the selection and poses were unchanged: nothing was rebuilt
+};
+
+class LocalMap {
+ public:
+  // Throws std::invalid_argument when config.validate() fails.
+  explicit LocalMap(const LocalMapConfig& config = {});
+  ~LocalMap();
+  LocalMap(LocalMap&&) noexcept;
+  LocalMap& operator=(LocalMap&&) noexcept;
+  LocalMap(const LocalMap&) = delete;
+  LocalMap& operator=(const LocalMap&) = delete;
+
+  // Stores a keyframe (features in the lidar frame, T_world_lidar its pose) and returns its index. Keyframes
+  // should arrive in time order (the recent window is measured from the last one added). Throws
+  // std::invalid_argument on a non-finite pose.
+  std::size_t addKeyframe(const FeatureSet& features, const Eigen::Isometry3d& T_world_lidar);
+  // Corrects a keyframe's pose (loop closure); its cached world clouds are dropped and the next build()
+  // reassembles. Throws std::invalid_argument on a bad index or non-finite pose.
+  void updatePose(std::size_t index, const Eigen::Isometry3d& T_world_lidar);
+
+  // Assembles the local map around `center_world` [m] (usually the last keyframe's or the guess's position).
+  // With no keyframes the assembled clouds are empty.
+  LocalMapBuild build(const Eigen::Vector3d& center_world);
+
+  // The assembled local map (world frame), valid until the next build()/move.
+  const PointCloud& edgesWorld() const;
+  const PointCloud& planesWorld() const;
+  const std::vector<std::size_t>& assembledKeyframes() const;
+
+  // The k nearest assembled edge / plane points of p_world, k = indices.size() (== sq_dists.size()), sorted by
+  // distance; returns how many were found (fewer only when the cloud is smaller than k). sq_dists in [m^2].
+  std::size_t nearestEdges(const Eigen::Vector3f& p_world, std::span<std::uint32_t> indices,
+                           std::span<float> sq_dists) const;
+  std::size_t nearestPlanes(const Eigen::Vector3f& p_world, std::span<std::uint32_t> indices,
+                            std::span<float> sq_dists) const;
+
+  std::size_t size() const;
+  const Keyframe& keyframe(std::size_t index) const;  // throws std::invalid_argument when out of range
+  std::vector<Eigen::Isometry3d> poses() const;       // T_world_lidar of every keyframe, by index
+
+  // The full clouds of the given keyframes in the world frame, concatenated in the given order and then
+  // voxel-downsampled with `leaf` [m] (0 keeps every point). For map export and loop-closure ICP. Throws
+  // std::invalid_argument on a bad index.
+  PointCloud fullCloudWorld(std::span<const std::size_t> indices, float leaf = 0.0f) const;
+
+  const LocalMapConfig& config() const { return config_; }
+
+ private:
+  struct Impl;
+  LocalMapConfig config_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drover::lidar

@@ -1,0 +1,137 @@
+#include "pipeline/imu_fusion.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+#include <vector>
+
+#include "pipeline/lidar_odometry.hpp"
+#include "pipeline/motion_models.hpp"
+
+namespace drover::pipeline {
+namespace {
+
+void appendWarning(ScanOutcome& out, const std::string& w) { out.warning += (out.warning.empty() ? "" : "; ") + w; }
+
+// Velocity of the IMU from the last two lidar poses [m/s] (for a restart), zero with fewer.
+Eigen::Vector3d velocityFrom(const Trajectory& trajectory, const Eigen::Isometry3d& T_lidar_imu) {
+  if (trajectory.size() < 2) return Eigen::Vector3d::Zero();
+  const StampedPose& a = trajectory[trajectory.size() - 2];
+  const StampedPose& b = trajectory.back();
+  const double dt = toSeconds(b.t - a.t);
+  if (!(dt > 0)) return Eigen::Vector3d::Zero();
+  return ((b.T_world_body * T_lidar_imu).translation() - (a.T_world_body * T_lidar_imu).translation()) / dt;
+}
+
+}  // namespace
+
+ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_imu_lidar)
+    : config_(config),
+      T_imu_lidar_(T_imu_lidar),
+      T_lidar_imu_(T_imu_lidar.inverse()),
+      propagator_(config.propagator),
+      initializer_(config.initializer),
+      smoother_(config.smoother) {}
+
+void ImuFusion::addImu(const ImuSample& sample) { propagator_.addSample(sample); }
+
+bool ImuFusion::wantsImu() const { return config_.use_imu && !given_up_ && propagator_.stats().accepted > 0; }
+
+Time ImuFusion::coverageNeeded(Time t0, Time t_end, bool first_sweep) const {
+  if (!first_sweep || initialized_) return t_end;
+  return std::max(t_end, t0 + fromSeconds(config_.initializer.window_s));
+}
+
+void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
+  if (initialized_ || given_up_ || !config_.use_imu) return;
+  if (!first_sweep || propagator_.stats().accepted == 0) {
+    // The world frame is fixed by the first sweep; an IMU that starts later cannot be aligned to it here.
+    given_up_ = true;
+    init_note_ = first_sweep ? "no IMU sample before the first sweep: lidar only"
+                             : "IMU data started after the first sweep: lidar only";
+    return;
+  }
+  const Time window_end = t0 + fromSeconds(config_.initializer.window_s);
+  std::vector<ImuSample> window;
+  for (const ImuSample& s : propagator_.samples())
+    if (s.t <= window_end) window.push_back(s);
+  const imu::StaticInitializer::Result r = initializer_.initialize(window);
+  if (!r.ok) {
+    given_up_ = true;
+    init_note_ = "IMU initialisation failed (" + r.reason + "): lidar only";
+    return;
+  }
+  T_world_imu0_ = Eigen::Isometry3d(r.q_world_imu.normalized());
+  imu::NavState state;
+  state.t = t0;
+  state.T_world_imu = T_world_imu0_;
+  restart(state, r.bias);
+  initialized_ = true;
+  init_note_ = r.is_static
+                   ? fmt::format("static start: gravity {:.3f} m/s^2, gyro bias ({:.4f}, {:.4f}, {:.4f}) rad/s{}",
+                                 r.gravity_magnitude, r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z(),
+                                 r.used_orientation ? ", attitude from the 9-axis orientation" : "")
+                   : "moving start (" + r.reason + "): attitude from the mean specific force, velocity 0";
+}
+
+void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias) {
+  smoother_.reset();
+  smoother_.initialize(state, bias, config_.preintegration);
+  propagator_.reset(state, bias);
+}
+
+std::optional<lidar::SweepMotion> ImuFusion::sweepMotion(Time t0, Time t_end) const {
+  if (!initialized_) return std::nullopt;
+  return imuMotion(propagator_, T_imu_lidar_, t0, t_end);
+}
+
+std::optional<Eigen::Isometry3d> ImuFusion::predictLidarPose(Time t) const {
+  if (!initialized_) return std::nullopt;
+  const std::optional<imu::NavState> s = propagator_.stateAt(t);
+  if (!s) return std::nullopt;
+  return s->T_world_imu * T_imu_lidar_;
+}
+
+Eigen::Isometry3d ImuFusion::initialLidarPose() const {
+  return initialized_ ? Eigen::Isometry3d(T_world_imu0_ * T_imu_lidar_) : Eigen::Isometry3d::Identity();
+}
+
+void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
+  if (!initialized_) return;
+  const imu::NavState previous = smoother_.state();
+  if (out.t <= previous.t) return;  // the first sweep: the smoother starts there
+  const Eigen::Isometry3d T_world_imu_measured = out.T_world_lidar * T_lidar_imu_;
+  const std::vector<ImuSample> samples = propagator_.samplesCovering(previous.t, out.t);
+  if (samples.empty()) {
+    appendWarning(out, "IMU does not cover the sweep: smoother restarted at the lidar pose");
+    out.reset = true;
+    restart({out.t, T_world_imu_measured, velocityFrom(trajectory, T_lidar_imu_)}, smoother_.bias());
+    return;
+  }
+  const bool weak = out.degenerate || !out.match_usable;
+  const double sp = weak ? config_.degenerate_sigma : config_.lidar_sigma_position;
+  const double sr = weak ? config_.degenerate_sigma : config_.lidar_sigma_rotation;
+  Eigen::Matrix<double, 6, 6> L = Eigen::Matrix<double, 6, 6>::Zero();
+  L.diagonal() << Eigen::Vector3d::Constant(1.0 / sp), Eigen::Vector3d::Constant(1.0 / sr);
+  backend::SmootherUpdate r;
+  try {
+    imu::Preintegrator pim(smoother_.bias(), config_.preintegration);
+    pim.integrateRange(samples, previous.t, out.t);
+    r = smoother_.update(pim, T_world_imu_measured, L);
+  } catch (const std::invalid_argument& e) {
+    r.failure = true;
+    r.reason = e.what();
+  }
+  if (!r.ok) {
+    appendWarning(out, "smoother reset: " + r.reason);
+    out.reset = true;
+    const imu::ImuBias bias = r.bias.gyro.allFinite() && r.bias.acc.allFinite() ? r.bias : imu::ImuBias{};
+    restart({out.t, T_world_imu_measured, velocityFrom(trajectory, T_lidar_imu_)}, bias);
+    return;
+  }
+  propagator_.reset(r.state, r.bias);
+  // A failed match kept its guess; the fused state (IMU plus a weak pose prior) is the better pose then.
+  if (weak && !out.degenerate) out.T_world_lidar = r.state.T_world_imu * T_imu_lidar_;
+}
+
+}  // namespace drover::pipeline

@@ -1,0 +1,65 @@
+#pragma once
+// The IMU side of the LIS (LIO-SAM's imuPreintegration node): static initialisation of attitude and gyro bias,
+// high-rate propagation for deskewing and initial guesses, and the fixed-lag smoother that fuses each sweep's
+// lidar pose with the preintegrated IMU to estimate velocity and biases. Failure of the smoother (implausible
+// velocity or bias) resets it at the lidar pose, as LIO-SAM's failureDetection does.
+#include <Eigen/Geometry>
+#include <optional>
+#include <string>
+
+#include "backend/fixed_lag_smoother.hpp"
+#include "imu/initializer.hpp"
+#include "imu/propagator.hpp"
+#include "lidar/deskew.hpp"
+#include "pipeline/odometry_config.hpp"
+#include "types/imu.hpp"
+#include "types/trajectory.hpp"
+
+namespace drover::pipeline {
+
+struct ScanOutcome;
+
+class ImuFusion {
+ public:
+  // T_imu_lidar: the lidar's pose on the IMU (body).
+  ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_imu_lidar);
+
+  void addImu(const ImuSample& sample);
+  // True when sweeps should wait for IMU data: the IMU is enabled, has produced samples and was not given up.
+  bool wantsImu() const;
+  Time latestImuTime() const { return propagator_.latestTime(); }
+  // The IMU time a sweep [t0, t_end] needs before it is processed: its end, and for the very first sweep also
+  // the initialisation window after t0.
+  Time coverageNeeded(Time t0, Time t_end, bool first_sweep) const;
+
+  // At the first sweep (t0 [ns]): initialises attitude and gyro bias from the IMU window and starts the smoother
+  // and the propagation there. Gives the IMU up (lidar only, with a note) when that is impossible.
+  void tryInitialize(Time t0, bool first_sweep);
+  bool initialized() const { return initialized_; }
+  const std::string& initNote() const { return init_note_; }
+
+  std::optional<lidar::SweepMotion> sweepMotion(Time t0, Time t_end) const;
+  std::optional<Eigen::Isometry3d> predictLidarPose(Time t) const;
+  // Pose of the first sweep: gravity-aligned from the IMU attitude when initialised, else the identity.
+  Eigen::Isometry3d initialLidarPose() const;
+
+  // Fuses the sweep's matched pose (out.T_world_lidar at out.t) with the IMU since the previous sweep; sets
+  // out.reset / out.warning on a smoother failure, and replaces a failed match's pose by the fused one.
+  void update(ScanOutcome& out, const Trajectory& trajectory);
+
+  imu::ImuStreamStats imuStats() const { return propagator_.stats(); }
+
+ private:
+  void restart(const imu::NavState& state, const imu::ImuBias& bias);
+
+  OdometryConfig config_;
+  Eigen::Isometry3d T_imu_lidar_, T_lidar_imu_;
+  imu::ImuPropagator propagator_;
+  imu::StaticInitializer initializer_;
+  backend::FixedLagSmoother smoother_;
+  bool initialized_ = false, given_up_ = false;
+  std::string init_note_ = "no IMU data";
+  Eigen::Isometry3d T_world_imu0_ = Eigen::Isometry3d::Identity();
+};
+
+}  // namespace drover::pipeline

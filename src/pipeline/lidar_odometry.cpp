@@ -1,0 +1,258 @@
+#include "pipeline/lidar_odometry.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <deque>
+#include <stdexcept>
+
+#include "lidar/deskew.hpp"
+#include "lidar/voxel_filter.hpp"
+#include "pipeline/imu_fusion.hpp"
+#include "pipeline/motion_models.hpp"
+
+namespace drover::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+struct LidarOdometry::Impl {
+  OdometryConfig config;
+  Calibration calibration;
+  lidar::Deskewer deskewer;
+  lidar::FeatureExtractor extractor;
+  lidar::LocalMap map;
+  lidar::ScanMatcher matcher;
+  lidar::KeyframePolicy policy;
+  ImuFusion fusion;
+  std::deque<LidarScan> pending;  // sweeps waiting for the IMU to cover their end (time order)
+  Trajectory trajectory;          // T_world_lidar per processed sweep
+  std::vector<Time> keyframe_times;
+  Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
+  OdometryStats stats;
+  Time last_scan_t = 0;
+  bool have_scan = false;
+
+  Impl(const OdometryConfig& c, const Calibration& calib)
+      : config(c),
+        calibration(calib),
+        deskewer(lidar::DeskewerConfig{}),
+        extractor(c.features),
+        map(c.local_map),
+        matcher(c.matcher),
+        policy(c.keyframes),
+        fusion(c, calib.T_imu_lidar) {}
+
+  std::vector<ScanOutcome> onScan(LidarScan scan);
+  std::vector<ScanOutcome> drain(bool force);
+  std::optional<ScanOutcome> processScan(LidarScan& scan);
+  bool preprocess(LidarScan& scan, ScanOutcome& out);
+  Eigen::Isometry3d guess(Time t, bool& from_imu) const;
+  void match(const lidar::FeatureSet& features, const Eigen::Isometry3d& guess, ScanOutcome& out);
+  void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
+};
+
+LidarOdometry::LidarOdometry(const OdometryConfig& config, const Calibration& calibration) {
+  if (std::string e = config.validate(); !e.empty()) throw std::invalid_argument("odometry config: " + e);
+  impl_ = std::make_unique<Impl>(config, calibration);
+}
+
+LidarOdometry::~LidarOdometry() = default;
+
+std::vector<ScanOutcome> LidarOdometry::process(const Measurement& m) {
+  if (const auto* imu = std::get_if<ImuSample>(&m)) {
+    if (impl_->config.use_imu) impl_->fusion.addImu(*imu);
+    return impl_->drain(false);
+  }
+  if (const auto* scan = std::get_if<LidarScan>(&m)) return impl_->onScan(*scan);
+  return {};  // camera frames belong to the VIS
+}
+
+std::vector<ScanOutcome> LidarOdometry::finish() { return impl_->drain(true); }
+
+const Trajectory& LidarOdometry::trajectory() const { return impl_->trajectory; }
+
+Trajectory LidarOdometry::keyframeTrajectory() const {
+  Trajectory out;
+  for (std::size_t i = 0; i < impl_->map.size(); ++i)
+    out.push_back({impl_->map.keyframe(i).t, impl_->map.keyframe(i).T_world_lidar});
+  return out;
+}
+
+lidar::PointCloud LidarOdometry::mapCloud(float leaf) const {
+  std::vector<std::size_t> all(impl_->map.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
+  return impl_->map.fullCloudWorld(all, leaf);
+}
+
+const OdometryStats& LidarOdometry::stats() const {
+  impl_->stats.imu = impl_->fusion.imuStats();
+  return impl_->stats;
+}
+
+const OdometryConfig& LidarOdometry::config() const { return impl_->config; }
+
+// Sweeps are stamped at their start; t_imu = t_lidar + offset puts them on the IMU's clock.
+std::vector<ScanOutcome> LidarOdometry::Impl::onScan(LidarScan scan) {
+  ++stats.scans_in;
+  scan.t += calibration.lidar_time_offset;
+  scan.t_end += calibration.lidar_time_offset;
+  const Time last = !pending.empty() ? pending.back().t : (have_scan ? last_scan_t : scan.t - 1);
+  if (scan.t <= last) {
+    ++stats.scans_skipped_time;
+    return {};
+  }
+  pending.push_back(std::move(scan));
+  return drain(false);
+}
+
+// Processes waiting sweeps in order: each once the IMU covers its end (or at once without an IMU); when `force`,
+// or when a later sweep is already imu_wait past a sweep's end, that sweep goes without full IMU coverage.
+std::vector<ScanOutcome> LidarOdometry::Impl::drain(bool force) {
+  std::vector<ScanOutcome> out;
+  while (!pending.empty()) {
+    LidarScan& scan = pending.front();
+    const Time end = fusion.coverageNeeded(scan.t, std::max(scan.t, scan.t_end), trajectory.empty());
+    const bool waiting = fusion.wantsImu() && fusion.latestImuTime() < end;
+    const bool overdue = pending.back().t > end + fromSeconds(config.imu_wait);
+    if (waiting && !force && !overdue) break;
+    if (std::optional<ScanOutcome> o = processScan(scan)) out.push_back(std::move(*o));
+    pending.pop_front();
+  }
+  return out;
+}
+
+std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
+  const auto t_start = Clock::now();
+  ScanOutcome out;
+  out.t = scan.t;
+  auto t0 = Clock::now();
+  if (!preprocess(scan, out)) return std::nullopt;
+  out.ms.preprocess = msSince(t0);
+
+  if (config.use_imu) fusion.tryInitialize(scan.t, trajectory.empty());
+  t0 = Clock::now();
+  std::optional<lidar::SweepMotion> motion;
+  if (config.deskew) {
+    motion = fusion.sweepMotion(scan.t, scan.t_end);
+    out.imu_used = motion.has_value();
+    if (!motion && trajectory.size() >= 2)
+      motion = lidar::constantVelocityMotion(trajectory[trajectory.size() - 2].T_world_body.inverse() *
+                                                 trajectory.back().T_world_body,
+                                             toSeconds(trajectory.back().t - trajectory[trajectory.size() - 2].t));
+  }
+  const LidarScan deskewed = motion ? deskewer.deskew(scan, *motion).scan : scan;
+  out.ms.deskew = msSince(t0);
+
+  t0 = Clock::now();
+  const lidar::FeatureSet features = extractor.extract(deskewed).features;
+  out.edges = features.edges.size();
+  out.planes = features.planes.size();
+  out.ms.features = msSince(t0);
+
+  bool from_imu = false;
+  const Eigen::Isometry3d T_guess = guess(scan.t, from_imu);
+  out.imu_used = out.imu_used || from_imu;
+  match(features, T_guess, out);
+
+  t0 = Clock::now();
+  fusion.update(out, trajectory);
+  out.ms.smoother = msSince(t0);
+  if (out.reset) {
+    ++stats.smoother_resets;
+    stats.reset_times.push_back(scan.t);
+  }
+  if (out.imu_used) ++stats.imu_scans;
+
+  keyframe(features, out);
+  trajectory.push_back({scan.t, out.T_world_lidar});
+  last_scan_t = scan.t;
+  have_scan = true;
+  ++stats.scans_processed;
+  stats.imu_initialized = fusion.initialized();
+  stats.imu_init = fusion.initNote();
+  out.ms.total = msSince(t_start);
+  return out;
+}
+
+// Drops bad points and fills in ring/time when the lidar gives none; false when too little is left.
+bool LidarOdometry::Impl::preprocess(LidarScan& scan, ScanOutcome& out) {
+  const lidar::SanitizeResult s = lidar::sanitize(scan, config.layout);
+  stats.points_dropped += s.non_finite + s.too_close + s.too_far;
+  if (s.non_finite > 0) out.warning = fmt::format("{} non-finite points dropped", s.non_finite);
+  out.points = scan.points.size();
+  if (static_cast<int>(scan.points.size()) < config.min_points) {
+    ++stats.scans_skipped_empty;
+    return false;
+  }
+  if (!scan.has_time) lidar::inferTimes(scan, config.layout);
+  if (!scan.has_ring) lidar::inferRings(scan, config.layout);
+  if (scan.t_end <= scan.t) scan.t_end = scan.t + fromSeconds(config.layout.scan_period);
+  return true;
+}
+
+// IMU prediction when the fusion is running, else constant velocity from the last two poses.
+Eigen::Isometry3d LidarOdometry::Impl::guess(Time t, bool& from_imu) const {
+  if (std::optional<Eigen::Isometry3d> p = fusion.predictLidarPose(t)) {
+    from_imu = true;
+    return *p;
+  }
+  from_imu = false;
+  if (trajectory.empty()) return fusion.initialLidarPose();
+  if (trajectory.size() == 1) return trajectory.back().T_world_body;
+  const StampedPose& a = trajectory[trajectory.size() - 2];
+  const StampedPose& b = trajectory.back();
+  return constantVelocityGuess(b.T_world_body, a.T_world_body.inverse() * b.T_world_body, toSeconds(b.t - a.t),
+                               toSeconds(t - b.t));
+}
+
+void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::Isometry3d& T_guess,
+                                ScanOutcome& out) {
+  out.T_world_lidar = T_guess;
+  if (map.size() == 0) {
+    out.match_status = "first";
+    out.converged = out.match_usable = true;
+    return;
+  }
+  auto t0 = Clock::now();
+  map.build(T_guess.translation());
+  out.ms.map = msSince(t0);
+  t0 = Clock::now();
+  const lidar::MatchResult r = matcher.align(features, map, T_guess);
+  out.ms.match = msSince(t0);
+  out.T_world_lidar = r.T_world_lidar;
+  out.match_status = lidar::toString(r.status);
+  out.converged = r.converged;
+  out.degenerate = r.degenerate;
+  out.degenerate_count = r.degenerate_count;
+  out.iterations = r.iterations;
+  out.fitness = r.fitness;
+  out.edge_inliers = r.edge_inliers;
+  out.plane_inliers = r.plane_inliers;
+  if (r.degenerate) {
+    ++stats.degenerate_scans;
+    stats.degenerate_times.push_back(out.t);
+  }
+  out.match_usable = r.status == lidar::MatchStatus::kConverged || r.status == lidar::MatchStatus::kMaxIterations;
+  if (!out.match_usable) {
+    ++stats.not_converged;
+    out.warning += (out.warning.empty() ? "" : "; ") + std::string("match failed (") + r.reason + "): pose predicted";
+  }
+}
+
+void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcome& out) {
+  const bool first = map.size() == 0;
+  if (!first && !policy.isKeyframe(T_world_lastkf, out.T_world_lidar)) return;
+  map.addKeyframe(features, out.T_world_lidar);
+  T_world_lastkf = out.T_world_lidar;
+  out.keyframe = true;
+  ++stats.keyframes;
+}
+
+}  // namespace drover::pipeline

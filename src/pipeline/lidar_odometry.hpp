@@ -1,0 +1,96 @@
+#pragma once
+// The lidar-inertial odometry (LIS) driven measurement by measurement, in time order, single-threaded: the
+// deterministic replay that `drover run` and the system tests use. Per lidar sweep (LIO-SAM's chain):
+//   sanitize -> ring/time inference (when the lidar gives none) -> deskew (IMU propagation, or a constant-velocity
+//   model without an IMU) -> LOAM features -> initial guess (IMU prediction or constant velocity) -> scan-to-local-
+//   map matching -> fixed-lag smoother (IMU preintegration + lidar pose factors; velocity and biases) -> keyframe.
+// IMU samples go to the propagator; camera frames are ignored by the LIS. Every bad input (non-finite points,
+// empty scans, stamps going backwards or repeating, IMU gaps and spikes, a diverging smoother) is handled with a
+// counted warning, never a crash: see OdometryStats.
+#include <Eigen/Geometry>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imu/initializer.hpp"
+#include "imu/preintegration.hpp"
+#include "imu/propagator.hpp"
+#include "lidar/feature_set.hpp"
+#include "pipeline/odometry_config.hpp"
+#include "types/calibration.hpp"
+#include "types/measurement.hpp"
+#include "types/trajectory.hpp"
+
+namespace drover::pipeline {
+
+// Wall time of each stage for one sweep [ms].
+struct StageTimes {
+  double preprocess = 0, deskew = 0, features = 0, map = 0, match = 0, smoother = 0, total = 0;
+};
+
+// What happened to one sweep.
+struct ScanOutcome {
+  Time t = 0;                                                       // [ns] sweep start (the pose's time)
+  Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();  // estimate at t
+  bool keyframe = false;
+  bool imu_used = false;          // deskew and guess came from the IMU propagation
+  std::string match_status;       // lidar::toString(MatchStatus), "first" for the first sweep
+  bool converged = false;
+  bool match_usable = false;      // converged or stopped at the iteration limit (else the pose is a prediction)
+  bool degenerate = false;
+  int degenerate_count = 0;       // degenerate directions of the match
+  int iterations = 0;
+  double fitness = 0;             // [m] RMS point-to-feature distance
+  int edge_inliers = 0, plane_inliers = 0;
+  std::size_t points = 0, edges = 0, planes = 0;  // valid points in, features out
+  bool reset = false;             // the smoother diverged and was reset at this sweep
+  std::string warning;            // one line when something was off with this sweep
+  StageTimes ms;
+};
+
+struct OdometryStats {
+  std::size_t scans_in = 0;              // sweeps received
+  std::size_t scans_processed = 0;       // sweeps that produced a pose
+  std::size_t scans_skipped_empty = 0;   // too few valid points to match
+  std::size_t scans_skipped_time = 0;    // stamp not after the previous sweep's (duplicate or backwards)
+  std::size_t points_dropped = 0;        // non-finite or out-of-range points removed
+  std::size_t keyframes = 0;
+  std::size_t degenerate_scans = 0;
+  std::size_t not_converged = 0;         // matches that stopped without converging (pose kept from the guess)
+  std::size_t smoother_resets = 0;
+  std::size_t imu_scans = 0;             // sweeps deskewed and predicted with the IMU
+  bool imu_initialized = false;
+  std::string imu_init;                  // how the IMU was initialised (or why not)
+  imu::ImuStreamStats imu;
+  std::vector<Time> degenerate_times;    // [ns] sweep times of degenerate matches
+  std::vector<Time> reset_times;         // [ns] sweep times of smoother resets
+};
+
+class LidarOdometry {
+ public:
+  // Throws std::invalid_argument when the config is invalid (names the bad value).
+  LidarOdometry(const OdometryConfig& config, const Calibration& calibration);
+  ~LidarOdometry();
+  LidarOdometry(const LidarOdometry&) = delete;
+  LidarOdometry& operator=(const LidarOdometry&) = delete;
+
+  // Feeds one measurement (time order). With an IMU a sweep waits until the IMU covers its end (readers emit a
+  // sweep at its start time), so the outcomes returned are those of the sweeps completed by this measurement.
+  std::vector<ScanOutcome> process(const Measurement& measurement);
+  // Processes the sweeps still waiting for IMU data (end of the stream).
+  std::vector<ScanOutcome> finish();
+
+  const Trajectory& trajectory() const;     // T_world_lidar at every processed sweep's start
+  Trajectory keyframeTrajectory() const;    // T_world_lidar of the keyframes
+  // The keyframes' full clouds in the world frame, voxel-downsampled with leaf [m].
+  lidar::PointCloud mapCloud(float leaf) const;
+  const OdometryStats& stats() const;
+  const OdometryConfig& config() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drover::pipeline

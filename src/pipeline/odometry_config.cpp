@@ -1,0 +1,32 @@
+#include "pipeline/odometry_config.hpp"
+
+#include <cmath>
+
+namespace drover::pipeline {
+namespace {
+
+std::string prefixed(const char* component, const std::string& error) {
+  return error.empty() ? error : std::string(component) + ": " + error;
+}
+
+}  // namespace
+
+std::string OdometryConfig::validate() const {
+  if (min_points < 1) return "min_points must be >= 1, got " + std::to_string(min_points);
+  for (const auto& [name, v] : {std::pair<const char*, double>{"imu_wait", imu_wait},
+                                {"lidar_sigma_position", lidar_sigma_position},
+                                {"lidar_sigma_rotation", lidar_sigma_rotation},
+                                {"degenerate_sigma", degenerate_sigma}})
+    if (!std::isfinite(v) || v <= 0) return std::string(name) + " must be finite and > 0, got " + std::to_string(v);
+  const std::pair<const char*, std::string> parts[] = {
+      {"layout", layout.validate()},          {"features", features.validate()},
+      {"local_map", local_map.validate()},    {"matcher", matcher.validate()},
+      {"keyframes", keyframes.validate()},    {"preintegration", preintegration.validate()},
+      {"propagator", propagator.validate()},  {"initializer", initializer.validate()},
+      {"smoother", smoother.validate()}};
+  for (const auto& [name, error] : parts)
+    if (!error.empty()) return prefixed(name, error);
+  return {};
+}
+
+}  // namespace drover::pipeline

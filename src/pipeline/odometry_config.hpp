@@ -1,0 +1,44 @@
+#pragma once
+// Settings of the lidar-inertial odometry: one Config per component (their units are in their own headers) and
+// the few that belong to the pipeline itself. Filled from a platform config's `odometry:` section by
+// io/odometry/odometry_config_io.hpp; defaults are LIO-SAM's.
+#include <string>
+
+#include "backend/fixed_lag_smoother.hpp"
+#include "imu/initializer.hpp"
+#include "imu/preintegration.hpp"
+#include "imu/propagator.hpp"
+#include "lidar/feature_extractor.hpp"
+#include "lidar/keyframe_policy.hpp"
+#include "lidar/local_map.hpp"
+#include "lidar/scan_layout.hpp"
+#include "lidar/scan_matcher.hpp"
+
+namespace drover::pipeline {
+
+struct OdometryConfig {
+  bool use_imu = true;                 // fuse the IMU when the dataset has one (false: lidar only)
+  bool deskew = true;                  // motion-compensate sweeps (IMU propagation, else constant velocity)
+  int min_points = 100;                // [-] sweeps with fewer valid points are skipped with a warning
+  // [s] a sweep waits for IMU samples up to its end; when a later sweep arrives this long after that end and the
+  // IMU still has not caught up (IMU dropout), the sweep is processed with the constant-velocity model instead.
+  double imu_wait = 0.3;
+  // [m], [rad] sigma of the lidar pose factor in the smoother (LIO-SAM correctionNoise 0.05 m / 0.05 rad; its
+  // degenerate-case noise, 1.0, is used when the match reports degenerate directions).
+  double lidar_sigma_position = 0.05;
+  double lidar_sigma_rotation = 0.05;
+  double degenerate_sigma = 1.0;
+  lidar::ScanLayoutConfig layout = lidar::ScanLayoutConfig::vlp16();
+  lidar::FeatureExtractorConfig features;
+  lidar::LocalMapConfig local_map;
+  lidar::ScanMatcherConfig matcher;
+  lidar::KeyframePolicyConfig keyframes;
+  imu::PreintegrationConfig preintegration;
+  imu::ImuPropagator::Config propagator;
+  imu::StaticInitializer::Config initializer;
+  backend::FixedLagSmootherConfig smoother;
+  // Empty when valid, else the first problem found, naming the component and value.
+  std::string validate() const;
+};
+
+}  // namespace drover::pipeline
