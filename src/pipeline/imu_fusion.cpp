@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <stdexcept>
 #include <vector>
 
@@ -24,6 +25,12 @@ Eigen::Vector3d velocityFrom(const Trajectory& trajectory, const Eigen::Isometry
 }
 
 }  // namespace
+
+Eigen::Matrix3d withRollPitchOf(const Eigen::Matrix3d& R_heading, const Eigen::Matrix3d& R_tilt) {
+  const double yaw_heading = std::atan2(R_heading(1, 0), R_heading(0, 0));
+  const double yaw_tilt = std::atan2(R_tilt(1, 0), R_tilt(0, 0));
+  return Eigen::AngleAxisd(yaw_heading - yaw_tilt, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_tilt;
+}
 
 ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_imu_lidar)
     : config_(config),
@@ -130,6 +137,8 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     return;
   }
   propagator_.reset(r.state, r.bias);
+  if (config_.gravity_roll_pitch && !weak)
+    out.T_world_lidar.linear() = withRollPitchOf(out.T_world_lidar.linear(), (r.state.T_world_imu * T_imu_lidar_).linear());
   // A failed match kept its guess; the fused state (IMU plus a weak pose prior) is the better pose then.
   if (weak && !out.degenerate) out.T_world_lidar = r.state.T_world_imu * T_imu_lidar_;
 }

@@ -19,6 +19,10 @@ namespace drover::pipeline {
 
 struct ScanOutcome;
 
+// R_tilt turned about the world z axis until its heading (the yaw of its x axis) is R_heading's: the tilt (roll,
+// pitch) of one rotation with the heading of the other. For ground robots (|pitch| well below 90 deg).
+Eigen::Matrix3d withRollPitchOf(const Eigen::Matrix3d& R_heading, const Eigen::Matrix3d& R_tilt);
+
 class ImuFusion {
  public:
   // T_imu_lidar: the lidar's pose on the IMU (body).
@@ -44,7 +48,9 @@ class ImuFusion {
   Eigen::Isometry3d initialLidarPose() const;
 
   // Fuses the sweep's matched pose (out.T_world_lidar at out.t) with the IMU since the previous sweep; sets
-  // out.reset / out.warning on a smoother failure, and replaces a failed match's pose by the fused one.
+  // out.reset / out.warning on a smoother failure, and replaces a failed match's pose by the fused one. With
+  // config.gravity_roll_pitch the sweep's roll and pitch become the smoother's: its IMU factors see gravity, while
+  // scan matching lets tilt drift (LIO-SAM blends the IMU's roll/pitch into the mapping pose for the same reason).
   void update(ScanOutcome& out, const Trajectory& trajectory);
 
   imu::ImuStreamStats imuStats() const { return propagator_.stats(); }

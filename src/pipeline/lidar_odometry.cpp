@@ -54,7 +54,10 @@ struct LidarOdometry::Impl {
   std::optional<ScanOutcome> processScan(LidarScan& scan);
   bool preprocess(LidarScan& scan, ScanOutcome& out);
   Eigen::Isometry3d guess(Time t, bool& from_imu) const;
+  lidar::FeatureSet deskewAndExtract(const LidarScan& scan, const std::optional<lidar::SweepMotion>& motion,
+                                     ScanOutcome& out) const;
   void match(const lidar::FeatureSet& features, const Eigen::Isometry3d& guess, ScanOutcome& out);
+  void countMatch(ScanOutcome& out);
   void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
 };
 
@@ -137,29 +140,30 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   out.ms.preprocess = msSince(t0);
 
   if (config.use_imu) fusion.tryInitialize(scan.t, trajectory.empty());
-  t0 = Clock::now();
   std::optional<lidar::SweepMotion> motion;
   if (config.deskew) {
     motion = fusion.sweepMotion(scan.t, scan.t_end);
     out.imu_used = motion.has_value();
-    if (!motion && trajectory.size() >= 2)
-      motion = lidar::constantVelocityMotion(trajectory[trajectory.size() - 2].T_world_body.inverse() *
-                                                 trajectory.back().T_world_body,
-                                             toSeconds(trajectory.back().t - trajectory[trajectory.size() - 2].t));
+    if (!motion && trajectory.size() >= 2) {
+      const StampedPose& a = trajectory[trajectory.size() - 2];
+      const StampedPose& b = trajectory.back();
+      motion = lidar::constantVelocityMotion(a.T_world_body.inverse() * b.T_world_body, toSeconds(b.t - a.t));
+    }
   }
-  const LidarScan deskewed = motion ? deskewer.deskew(scan, *motion).scan : scan;
-  out.ms.deskew = msSince(t0);
-
-  t0 = Clock::now();
-  const lidar::FeatureSet features = extractor.extract(deskewed).features;
-  out.edges = features.edges.size();
-  out.planes = features.planes.size();
-  out.ms.features = msSince(t0);
-
   bool from_imu = false;
   const Eigen::Isometry3d T_guess = guess(scan.t, from_imu);
   out.imu_used = out.imu_used || from_imu;
+  lidar::FeatureSet features = deskewAndExtract(scan, motion, out);
   match(features, T_guess, out);
+  // Constant-velocity deskew: again with the sweep's own estimated motion (see deskew_refinements).
+  const bool refine = motion && !out.imu_used && !trajectory.empty() && map.size() > 0;
+  for (int k = 0; refine && out.match_usable && k < config.deskew_refinements; ++k) {
+    const StampedPose& prev = trajectory.back();
+    motion = lidar::constantVelocityMotion(prev.T_world_body.inverse() * out.T_world_lidar, toSeconds(scan.t - prev.t));
+    features = deskewAndExtract(scan, motion, out);
+    match(features, out.T_world_lidar, out);
+  }
+  countMatch(out);
 
   t0 = Clock::now();
   fusion.update(out, trajectory);
@@ -212,6 +216,20 @@ Eigen::Isometry3d LidarOdometry::Impl::guess(Time t, bool& from_imu) const {
                                toSeconds(t - b.t));
 }
 
+lidar::FeatureSet LidarOdometry::Impl::deskewAndExtract(const LidarScan& scan,
+                                                        const std::optional<lidar::SweepMotion>& motion,
+                                                        ScanOutcome& out) const {
+  auto t0 = Clock::now();
+  const LidarScan deskewed = motion ? deskewer.deskew(scan, *motion).scan : scan;
+  out.ms.deskew += msSince(t0);
+  t0 = Clock::now();
+  lidar::FeatureSet features = extractor.extract(deskewed).features;
+  out.edges = features.edges.size();
+  out.planes = features.planes.size();
+  out.ms.features += msSince(t0);
+  return features;
+}
+
 void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::Isometry3d& T_guess,
                                 ScanOutcome& out) {
   out.T_world_lidar = T_guess;
@@ -222,10 +240,10 @@ void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::
   }
   auto t0 = Clock::now();
   map.build(T_guess.translation());
-  out.ms.map = msSince(t0);
+  out.ms.map += msSince(t0);
   t0 = Clock::now();
   const lidar::MatchResult r = matcher.align(features, map, T_guess);
-  out.ms.match = msSince(t0);
+  out.ms.match += msSince(t0);
   out.T_world_lidar = r.T_world_lidar;
   out.match_status = lidar::toString(r.status);
   out.converged = r.converged;
@@ -235,14 +253,21 @@ void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::
   out.fitness = r.fitness;
   out.edge_inliers = r.edge_inliers;
   out.plane_inliers = r.plane_inliers;
-  if (r.degenerate) {
+  out.match_usable = r.status == lidar::MatchStatus::kConverged || r.status == lidar::MatchStatus::kMaxIterations;
+  out.match_reason = r.reason;
+  if (!out.match_usable) out.T_world_lidar = T_guess;
+}
+
+// Counts the final match of a sweep (refinements re-match the same sweep).
+void LidarOdometry::Impl::countMatch(ScanOutcome& out) {
+  if (out.degenerate) {
     ++stats.degenerate_scans;
     stats.degenerate_times.push_back(out.t);
   }
-  out.match_usable = r.status == lidar::MatchStatus::kConverged || r.status == lidar::MatchStatus::kMaxIterations;
   if (!out.match_usable) {
     ++stats.not_converged;
-    out.warning += (out.warning.empty() ? "" : "; ") + std::string("match failed (") + r.reason + "): pose predicted";
+    out.warning += (out.warning.empty() ? "" : "; ") + std::string("match failed (") + out.match_reason +
+                   "): pose predicted";
   }
 }
 

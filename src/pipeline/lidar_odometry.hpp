@@ -36,6 +36,7 @@ struct ScanOutcome {
   bool keyframe = false;
   bool imu_used = false;          // deskew and guess came from the IMU propagation
   std::string match_status;       // lidar::toString(MatchStatus), "first" for the first sweep
+  std::string match_reason;       // the matcher's one-line reason
   bool converged = false;
   bool match_usable = false;      // converged or stopped at the iteration limit (else the pose is a prediction)
   bool degenerate = false;

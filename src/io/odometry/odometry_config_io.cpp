@@ -152,6 +152,8 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .bind("lidar_sigma_position", c.lidar_sigma_position)
       .bind("lidar_sigma_rotation", c.lidar_sigma_rotation)
       .bind("degenerate_sigma", c.degenerate_sigma)
+      .bind("gravity_roll_pitch", c.gravity_roll_pitch)
+      .bind("deskew_refinements", c.deskew_refinements)
       .nested("layout", [&](YamlSection& s) { bindLayout(s, c.layout, e); })
       .nested("features", [&](YamlSection& s) { bindFeatures(s, c.features, f); })
       .nested("local_map", [&](YamlSection& s) { bindLocalMap(s, c.local_map); })

@@ -1,0 +1,211 @@
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "backend/fixed_lag_smoother.hpp"
+#include "backend/pose_factors.hpp"
+#include "geometry/so3.hpp"
+#include "sim/imu_model.hpp"
+#include "sim/trajectory.hpp"
+
+using namespace drover;
+using namespace drover::backend;
+
+namespace {
+
+constexpr Time kSec = 1'000'000'000;
+constexpr Time kLidarPeriod = kSec / 10;  // 10 Hz lidar odometry
+
+// A 12 s ground-robot wander: ~2-3 m/s, turning both ways, gentle pitch, roll and climb, knots every 0.5 s.
+sim::SplineTrajectory wanderPath() {
+  std::vector<sim::PathSample> samples;
+  for (int k = 0; k <= 24; ++k) {
+    const double t = 0.5 * k;
+    sim::PathSample s;
+    s.t = k * kSec / 2;
+    s.p_world = {2.0 * t + std::sin(0.5 * t), 3.0 * std::sin(0.3 * t), 0.3 * std::sin(0.4 * t)};
+    s.yaw = 0.2 * t + 0.5 * std::sin(0.4 * t);
+    s.pitch = 0.04 * std::sin(0.7 * t);
+    s.roll = 0.05 * std::cos(0.9 * t);
+    samples.push_back(s);
+  }
+  return sim::SplineTrajectory(samples);
+}
+
+struct Scenario {
+  sim::SplineTrajectory trajectory = wanderPath();
+  sim::ImuModelConfig imu_model;
+  std::vector<ImuSample> imu;
+  imu::PreintegrationConfig preintegration;
+
+  Scenario() {
+    // Noisy IMU with constant, known biases (no random walk), as the smoother should recover them.
+    imu_model.gyro_bias_random_walk = 0;
+    imu_model.accel_bias_random_walk = 0;
+    imu_model.initial_gyro_bias = {0.004, -0.003, 0.002};
+    imu_model.initial_accel_bias = {0.05, -0.04, 0.06};
+    imu = sim::simulateImu(trajectory, imu_model, 7);
+    preintegration.gyro_noise_density = imu_model.gyro_noise_density;
+    preintegration.acc_noise_density = imu_model.accel_noise_density;
+  }
+
+  imu::NavState truth(Time t) const {
+    const sim::BodyState b = trajectory.at(t);
+    return {t, b.T_world_body, b.v_world};
+  }
+};
+
+// Lidar odometry: the true pose with N(0, sigma_p^2) on position and a right-perturbed N(0, sigma_r^2) rotation.
+struct PoseNoise {
+  double sigma_position = 0.02;  // [m]
+  double sigma_rotation = 0.005; // [rad]
+  std::mt19937 rng{11};
+  Eigen::Isometry3d apply(Eigen::Isometry3d T) {
+    std::normal_distribution<double> n(0.0, 1.0);
+    T.translation() += sigma_position * Eigen::Vector3d(n(rng), n(rng), n(rng));
+    T.linear() = T.linear() * geometry::expSO3(sigma_rotation * Eigen::Vector3d(n(rng), n(rng), n(rng)));
+    return T;
+  }
+};
+
+imu::Preintegrator preintegrate(const Scenario& s, Time t0, Time t1, const imu::ImuBias& bias_hat) {
+  imu::Preintegrator pim(bias_hat, s.preintegration);
+  pim.integrateRange(s.imu, t0, t1);
+  return pim;
+}
+
+bool finite(const imu::NavState& x, const imu::ImuBias& b) {
+  return x.T_world_imu.matrix().allFinite() && x.v_world.allFinite() && b.gyro.allFinite() && b.acc.allFinite();
+}
+
+}  // namespace
+
+TEST(FixedLagSmoother, RecoversVelocityAndConstantBiasesFromNoisyImuAndLidarPosesWithinTenSeconds) {
+  const Scenario s;
+  FixedLagSmoother smoother;  // window 10
+  smoother.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
+  PoseNoise noise;
+  const Matrix6d L = poseSqrtInformation(noise.sigma_position, noise.sigma_rotation);
+  double worst_ms = 0, total_ms = 0;
+  int max_iterations = 0, sum_iterations = 0;
+  const int updates = 100;
+  for (int k = 1; k <= updates; ++k) {
+    const Time t0 = (k - 1) * kLidarPeriod, t1 = k * kLidarPeriod;
+    const imu::Preintegrator pim = preintegrate(s, t0, t1, smoother.bias());
+    const auto start = std::chrono::steady_clock::now();
+    const SmootherUpdate u = smoother.update(pim, noise.apply(s.truth(t1).T_world_imu), L);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    worst_ms = std::max(worst_ms, ms);
+    total_ms += ms;
+    max_iterations = std::max(max_iterations, u.iterations);
+    sum_iterations += u.iterations;
+    ASSERT_TRUE(u.ok) << "update " << k << ": " << u.reason;
+    ASSERT_FALSE(u.failure);
+    ASSERT_EQ(u.state.t, t1);
+    ASSERT_TRUE(finite(u.state, u.bias));
+    ASSERT_EQ(smoother.size(), std::min(k + 1, 10)) << "window not respected at update " << k;
+    ASSERT_LE(u.final_cost, u.initial_cost + 1e-9);
+  }
+  const imu::NavState truth = s.truth(updates * kLidarPeriod);
+  const double v_error = (smoother.state().v_world - truth.v_world).norm();
+  const double p_error = (smoother.state().T_world_imu.translation() - truth.T_world_imu.translation()).norm();
+  const double bg_error = (smoother.bias().gyro - s.imu_model.initial_gyro_bias).norm();
+  const double ba_error = (smoother.bias().acc - s.imu_model.initial_accel_bias).norm();
+  std::printf("after 10 s: |dv| %.4f m/s, |dp| %.4f m, |dbg| %.2e rad/s, |dba| %.4f m/s^2; update %.2f ms mean, "
+              "%.2f ms worst, %.1f iterations mean, %d max\n",
+              v_error, p_error, bg_error, ba_error, total_ms / updates, worst_ms,
+              double(sum_iterations) / updates, max_iterations);
+  EXPECT_LT(v_error, 0.05);
+  EXPECT_LT(bg_error, 2e-3);
+  EXPECT_LT(ba_error, 0.05);
+  EXPECT_LT(p_error, 0.05);
+}
+
+TEST(FixedLagSmoother, SchurMarginalisationOfAShortWindowMatchesTheFullBatchSolution) {
+  // A linear(ised) Gaussian problem marginalised by the Schur complement loses nothing: a 3-state window must
+  // end where the 31-state batch (nothing marginalised) ends, up to the relinearisation of the dropped states.
+  const Scenario s;
+  FixedLagSmoother::Config short_window, batch;
+  short_window.window = 3;
+  batch.window = 1000;
+  FixedLagSmoother a(short_window), b(batch);
+  a.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
+  b.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
+  PoseNoise noise;
+  for (int k = 1; k <= 30; ++k) {
+    const Time t0 = (k - 1) * kLidarPeriod, t1 = k * kLidarPeriod;
+    const imu::Preintegrator pim = preintegrate(s, t0, t1, imu::ImuBias{});
+    const Eigen::Isometry3d T = noise.apply(s.truth(t1).T_world_imu);
+    ASSERT_TRUE(a.update(pim, T).ok);
+    ASSERT_TRUE(b.update(pim, T).ok);
+  }
+  EXPECT_EQ(a.size(), 3);
+  EXPECT_EQ(b.size(), 31);
+  const double dp = (a.state().T_world_imu.translation() - b.state().T_world_imu.translation()).norm();
+  const double dv = (a.state().v_world - b.state().v_world).norm();
+  const double dbg = (a.bias().gyro - b.bias().gyro).norm(), dba = (a.bias().acc - b.bias().acc).norm();
+  std::printf("window 3 vs batch 31: |dp| %.2e m, |dv| %.2e m/s, |dbg| %.2e rad/s, |dba| %.2e m/s^2\n", dp, dv,
+              dbg, dba);
+  EXPECT_LT(dp, 1e-3);
+  EXPECT_LT(dv, 1e-3);
+  EXPECT_LT(dbg, 1e-4);
+  EXPECT_LT(dba, 1e-3);
+}
+
+TEST(FixedLagSmoother, APoseMeasurementHundredMetresOffIsReportedAsFailureAndRolledBack) {
+  const Scenario s;
+  FixedLagSmoother smoother;
+  smoother.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
+  PoseNoise noise;
+  for (int k = 1; k <= 10; ++k) {
+    const imu::Preintegrator pim = preintegrate(s, (k - 1) * kLidarPeriod, k * kLidarPeriod, smoother.bias());
+    ASSERT_TRUE(smoother.update(pim, noise.apply(s.truth(k * kLidarPeriod).T_world_imu)).ok);
+  }
+  const imu::NavState good = smoother.state();
+  const int size = smoother.size();
+  Eigen::Isometry3d wild = s.truth(11 * kLidarPeriod).T_world_imu;
+  wild.translation().x() += 100.0;
+  const SmootherUpdate u =
+      smoother.update(preintegrate(s, 10 * kLidarPeriod, 11 * kLidarPeriod, smoother.bias()), wild);
+  std::printf("failure reason: %s\n", u.reason.c_str());
+  EXPECT_TRUE(u.failure);
+  EXPECT_FALSE(u.ok);
+  EXPECT_NE(u.reason.find("velocity"), std::string::npos) << u.reason;
+  EXPECT_TRUE(finite(u.state, u.bias));
+  EXPECT_EQ(u.state.t, good.t);  // the last good state, the window rolled back
+  EXPECT_EQ(smoother.size(), size);
+  EXPECT_LT((smoother.state().T_world_imu.translation() - good.T_world_imu.translation()).norm(), 1e-12);
+  smoother.reset();
+  EXPECT_FALSE(smoother.initialized());
+  EXPECT_EQ(smoother.size(), 0);
+}
+
+TEST(FixedLagSmoother, RejectsInvalidConfigsAndUpdatesBeforeInitialisation) {
+  FixedLagSmoother::Config c;
+  EXPECT_EQ(c.validate(), "");
+  c.window = 1;
+  c.lidar_sigma_position = -1;
+  EXPECT_NE(c.validate().find("window = 1"), std::string::npos);
+  EXPECT_NE(c.validate().find("lidar_sigma_position"), std::string::npos);
+  EXPECT_THROW(FixedLagSmoother{c}, std::invalid_argument);
+
+  FixedLagSmoother smoother;
+  const imu::PreintegrationConfig imu_config;
+  imu::Preintegrator pim(imu::ImuBias{}, imu_config);
+  pim.integrate(Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 9.81), 0.1);
+  EXPECT_FALSE(smoother.initialized());
+  EXPECT_THROW(smoother.update(pim, Eigen::Isometry3d::Identity()), std::invalid_argument);
+  EXPECT_THROW(smoother.state(), std::logic_error);
+  smoother.initialize(imu::NavState{}, imu::ImuBias{}, imu_config);
+  const imu::Preintegrator empty(imu::ImuBias{}, imu_config);
+  EXPECT_THROW(smoother.update(empty, Eigen::Isometry3d::Identity()), std::invalid_argument);
+  // A robot at rest measured at rest stays at rest.
+  const SmootherUpdate u = smoother.update(pim, Eigen::Isometry3d::Identity());
+  EXPECT_TRUE(u.ok) << u.reason;
+  EXPECT_EQ(u.state.t, fromSeconds(0.1));
+  EXPECT_LT(u.state.v_world.norm(), 1e-6);
+  EXPECT_LT(u.state.T_world_imu.translation().norm(), 1e-6);
+}
