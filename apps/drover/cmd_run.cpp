@@ -105,6 +105,10 @@ void runOdometry(const RunOptions& o) {
     progress.update(record.scans.size(), since - o.start);
   }
   keep(odometry.finish(), record);
+  if (odometry.stats().scans_in == 0)
+    throw std::invalid_argument("dataset " + o.dataset + " has no lidar scans" +
+                                (o.start > 0 || o.duration > 0 ? " in the --start/--duration window" : "") +
+                                ": drover run needs a lidar (the visual-inertial subsystem is not built yet)");
   record.wall_s = progress.wallSeconds();
   record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
   RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt};

@@ -91,11 +91,13 @@ Json statsJson(const pipeline::OdometryStats& s) {
               {"dropped_nonfinite", s.imu.dropped_nonfinite},
               {"dropped_out_of_order", s.imu.dropped_out_of_order},
               {"dropped_spike", s.imu.dropped_spike}};
-  Json deg = Json::array(), resets = Json::array();
+  Json deg = Json::array(), resets = Json::array(), restarts = Json::array();
+  for (Time t : s.map_restart_times) restarts.push_back(toSeconds(t));
   for (Time t : s.degenerate_times) deg.push_back(toSeconds(t));
   for (Time t : s.reset_times) resets.push_back(toSeconds(t));
   j["degenerate_times_s"] = deg;
   j["reset_times_s"] = resets;
+  j["map_restart_times_s"] = restarts;
   return j;
 }
 

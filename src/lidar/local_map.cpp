@@ -119,11 +119,12 @@ namespace {
 
 // Surrounding keyframes thinned to the newest per density cube, plus the recent ones; ascending indices.
 std::vector<std::size_t> selectKeyframes(const std::vector<Keyframe>& keyframes, const LocalMapConfig& config,
-                                         const Eigen::Vector3d& center) {
+                                         const Eigen::Vector3d& center, std::size_t first) {
   std::vector<std::size_t> selected;
-  if (keyframes.empty()) return selected;
+  if (keyframes.size() <= first) return selected;
   std::map<std::tuple<std::int64_t, std::int64_t, std::int64_t>, std::size_t> newest_per_cell;
-  for (const auto& kf : keyframes) {
+  for (std::size_t k = first; k < keyframes.size(); ++k) {
+    const Keyframe& kf = keyframes[k];
     const Eigen::Vector3d p = kf.T_world_lidar.translation();
     if ((p - center).norm() > config.surrounding_radius) continue;
     if (config.keyframe_density <= 0.0) {
@@ -136,7 +137,7 @@ std::vector<std::size_t> selectKeyframes(const std::vector<Keyframe>& keyframes,
   }
   for (const auto& [cell, index] : newest_per_cell) selected.push_back(index);
   const Keyframe& newest = keyframes.back();
-  for (std::size_t i = 0; i < keyframes.size(); ++i) {
+  for (std::size_t i = first; i < keyframes.size(); ++i) {
     const bool in_window = config.recent_window > 0.0 &&
                            toSeconds(newest.t - keyframes[i].t) <= config.recent_window;
     const bool in_count = i + static_cast<std::size_t>(config.recent_count) >= keyframes.size();
@@ -149,11 +150,11 @@ std::vector<std::size_t> selectKeyframes(const std::vector<Keyframe>& keyframes,
 
 }  // namespace
 
-LocalMapBuild LocalMap::build(const Eigen::Vector3d& center_world) {
+LocalMapBuild LocalMap::build(const Eigen::Vector3d& center_world, std::size_t first_keyframe) {
   if (!center_world.allFinite()) throw std::invalid_argument("LocalMap::build: non-finite centre");
   Impl& m = *impl_;
   LocalMapBuild result;
-  result.keyframes = selectKeyframes(m.keyframes, config_, center_world);
+  result.keyframes = selectKeyframes(m.keyframes, config_, center_world, first_keyframe);
   const std::uint64_t stamp = ++m.build_count;
   if (result.keyframes == m.assembled && m.assembled_version == m.pose_version) {
     for (std::size_t index : result.keyframes) m.cache[index].last_used = stamp;

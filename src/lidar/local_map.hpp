@@ -73,9 +73,11 @@ class LocalMap {
   // reassembles. Throws std::invalid_argument on a bad index or non-finite pose.
   void updatePose(std::size_t index, const Eigen::Isometry3d& T_world_lidar);
 
-  // Assembles the local map around `center_world` [m] (usually the last keyframe's or the guess's position).
-  // With no keyframes the assembled clouds are empty.
-  LocalMapBuild build(const Eigen::Vector3d& center_world);
+  // Assembles the local map around `center_world` [m] (usually the last keyframe's or the guess's position) from
+  // the keyframes with index >= first_keyframe (the odometry starts a new submap there after a long degenerate
+  // stretch, whose drift makes older keyframes inconsistent with the current pose). With no keyframes the
+  // assembled clouds are empty.
+  LocalMapBuild build(const Eigen::Vector3d& center_world, std::size_t first_keyframe = 0);
 
   // The assembled local map (world frame), valid until the next build()/move.
   const PointCloud& edgesWorld() const;

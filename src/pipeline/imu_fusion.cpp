@@ -2,10 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Cholesky>
+
 #include <cmath>
 #include <stdexcept>
 #include <vector>
 
+#include "geometry/se3.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "pipeline/motion_models.hpp"
 
@@ -115,11 +118,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     restart({out.t, T_world_imu_measured, velocityFrom(trajectory, T_lidar_imu_)}, smoother_.bias());
     return;
   }
-  const bool weak = out.degenerate || !out.match_usable;
-  const double sp = weak ? config_.degenerate_sigma : config_.lidar_sigma_position;
-  const double sr = weak ? config_.degenerate_sigma : config_.lidar_sigma_rotation;
-  Eigen::Matrix<double, 6, 6> L = Eigen::Matrix<double, 6, 6>::Zero();
-  L.diagonal() << Eigen::Vector3d::Constant(1.0 / sp), Eigen::Vector3d::Constant(1.0 / sr);
+  const Eigen::Matrix<double, 6, 6> L = poseSqrtInformation(out, T_world_imu_measured);
   backend::SmootherUpdate r;
   try {
     imu::Preintegrator pim(smoother_.bias(), config_.preintegration);
@@ -137,10 +136,36 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     return;
   }
   propagator_.reset(r.state, r.bias);
-  if (config_.gravity_roll_pitch && !weak)
-    out.T_world_lidar.linear() = withRollPitchOf(out.T_world_lidar.linear(), (r.state.T_world_imu * T_imu_lidar_).linear());
-  // A failed match kept its guess; the fused state (IMU plus a weak pose prior) is the better pose then.
-  if (weak && !out.degenerate) out.T_world_lidar = r.state.T_world_imu * T_imu_lidar_;
+  const Eigen::Isometry3d T_world_lidar_fused = r.state.T_world_imu * T_imu_lidar_;
+  if (out.degenerate || !out.match_usable) {
+    // The lidar left some directions (or all) to the IMU: the fused state is the pose.
+    out.T_world_lidar = T_world_lidar_fused;
+  } else if (config_.gravity_roll_pitch) {
+    out.T_world_lidar.linear() = withRollPitchOf(out.T_world_lidar.linear(), T_world_lidar_fused.linear());
+  }
+}
+
+// Sigma of the lidar pose: lidar_sigma_position/rotation, plus degenerate_sigma along each degenerate direction of
+// the match (so the IMU carries those, e.g. along a featureless corridor), or degenerate_sigma on every axis when
+// the match failed. The covariance is built in the lidar's right-perturbation tangent [rho; phi] and mapped to the
+// smoother's error [dp_world; dtheta_imu]: xi_imu = Ad(T_imu_lidar) xi_lidar, dp_world = R_world_imu rho_imu.
+Eigen::Matrix<double, 6, 6> ImuFusion::poseSqrtInformation(const ScanOutcome& out,
+                                                           const Eigen::Isometry3d& T_world_imu) const {
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  Matrix6d cov_lidar = Matrix6d::Zero();
+  if (!out.match_usable) {
+    cov_lidar.diagonal().setConstant(config_.degenerate_sigma * config_.degenerate_sigma);
+  } else {
+    cov_lidar.diagonal() << Eigen::Vector3d::Constant(config_.lidar_sigma_position * config_.lidar_sigma_position),
+        Eigen::Vector3d::Constant(config_.lidar_sigma_rotation * config_.lidar_sigma_rotation);
+    for (const geometry::Vector6d& d : out.degenerate_directions)
+      cov_lidar += config_.degenerate_sigma * config_.degenerate_sigma * d.normalized() * d.normalized().transpose();
+  }
+  Matrix6d G = geometry::adjointSE3(T_imu_lidar_);
+  G.topRows<3>() = T_world_imu.linear() * G.topRows<3>();
+  const Matrix6d cov = G * cov_lidar * G.transpose();
+  const Matrix6d information = cov.inverse();
+  return Eigen::LLT<Matrix6d>(0.5 * (information + information.transpose())).matrixU();
 }
 
 }  // namespace drover::pipeline

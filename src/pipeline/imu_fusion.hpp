@@ -57,6 +57,7 @@ class ImuFusion {
 
  private:
   void restart(const imu::NavState& state, const imu::ImuBias& bias);
+  Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
 
   OdometryConfig config_;
   Eigen::Isometry3d T_imu_lidar_, T_lidar_imu_;

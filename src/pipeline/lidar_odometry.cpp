@@ -37,6 +37,8 @@ struct LidarOdometry::Impl {
   Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
   OdometryStats stats;
   Time last_scan_t = 0;
+  int degenerate_run = 0;               // consecutive degenerate sweeps
+  std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
   bool have_scan = false;
 
   Impl(const OdometryConfig& c, const Calibration& calib)
@@ -156,7 +158,7 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   lidar::FeatureSet features = deskewAndExtract(scan, motion, out);
   match(features, T_guess, out);
   // Constant-velocity deskew: again with the sweep's own estimated motion (see deskew_refinements).
-  const bool refine = motion && !out.imu_used && !trajectory.empty() && map.size() > 0;
+  const bool refine = motion && !out.imu_used && !trajectory.empty() && map.size() > map_first_keyframe;
   for (int k = 0; refine && out.match_usable && k < config.deskew_refinements; ++k) {
     const StampedPose& prev = trajectory.back();
     motion = lidar::constantVelocityMotion(prev.T_world_body.inverse() * out.T_world_lidar, toSeconds(scan.t - prev.t));
@@ -233,13 +235,13 @@ lidar::FeatureSet LidarOdometry::Impl::deskewAndExtract(const LidarScan& scan,
 void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::Isometry3d& T_guess,
                                 ScanOutcome& out) {
   out.T_world_lidar = T_guess;
-  if (map.size() == 0) {
+  if (map.size() <= map_first_keyframe) {
     out.match_status = "first";
     out.converged = out.match_usable = true;
     return;
   }
   auto t0 = Clock::now();
-  map.build(T_guess.translation());
+  map.build(T_guess.translation(), map_first_keyframe);
   out.ms.map += msSince(t0);
   t0 = Clock::now();
   const lidar::MatchResult r = matcher.align(features, map, T_guess);
@@ -249,6 +251,7 @@ void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::
   out.converged = r.converged;
   out.degenerate = r.degenerate;
   out.degenerate_count = r.degenerate_count;
+  out.degenerate_directions = r.degenerate_directions;
   out.iterations = r.iterations;
   out.fitness = r.fitness;
   out.edge_inliers = r.edge_inliers;
@@ -273,7 +276,16 @@ void LidarOdometry::Impl::countMatch(ScanOutcome& out) {
 
 void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcome& out) {
   const bool first = map.size() == 0;
-  if (!first && !policy.isKeyframe(T_world_lastkf, out.T_world_lidar)) return;
+  degenerate_run = out.degenerate ? degenerate_run + 1 : 0;
+  const bool restart = config.degenerate_restart_sweeps > 0 && degenerate_run == config.degenerate_restart_sweeps;
+  if (restart) {
+    map_first_keyframe = map.size();
+    stats.map_restart_times.push_back(out.t);
+    out.warning += std::string(out.warning.empty() ? "" : "; ") + fmt::format(
+        "{} degenerate sweeps in a row: local map restarted (new submap)", degenerate_run);
+  }
+  if (!first && !restart && !policy.isKeyframe(T_world_lastkf, out.T_world_lidar)) return;
+
   map.addKeyframe(features, out.T_world_lidar);
   T_world_lastkf = out.T_world_lidar;
   out.keyframe = true;

@@ -41,6 +41,7 @@ struct ScanOutcome {
   bool match_usable = false;      // converged or stopped at the iteration limit (else the pose is a prediction)
   bool degenerate = false;
   int degenerate_count = 0;       // degenerate directions of the match
+  std::vector<Eigen::Matrix<double, 6, 1>> degenerate_directions;  // unit, lidar tangent [rho; phi]
   int iterations = 0;
   double fitness = 0;             // [m] RMS point-to-feature distance
   int edge_inliers = 0, plane_inliers = 0;
@@ -66,6 +67,7 @@ struct OdometryStats {
   imu::ImuStreamStats imu;
   std::vector<Time> degenerate_times;    // [ns] sweep times of degenerate matches
   std::vector<Time> reset_times;         // [ns] sweep times of smoother resets
+  std::vector<Time> map_restart_times;   // [ns] sweeps where a long degenerate stretch restarted the local map
 };
 
 class LidarOdometry {

@@ -14,6 +14,8 @@ std::string prefixed(const char* component, const std::string& error) {
 std::string OdometryConfig::validate() const {
   if (deskew_refinements < 0 || deskew_refinements > 10)
     return "deskew_refinements must be in [0, 10], got " + std::to_string(deskew_refinements);
+  if (degenerate_restart_sweeps < 0)
+    return "degenerate_restart_sweeps must be >= 0, got " + std::to_string(degenerate_restart_sweeps);
   if (min_points < 1) return "min_points must be >= 1, got " + std::to_string(min_points);
   for (const auto& [name, v] : {std::pair<const char*, double>{"imu_wait", imu_wait},
                                 {"lidar_sigma_position", lidar_sigma_position},

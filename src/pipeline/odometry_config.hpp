@@ -23,11 +23,12 @@ struct OdometryConfig {
   // [s] a sweep waits for IMU samples up to its end; when a later sweep arrives this long after that end and the
   // IMU still has not caught up (IMU dropout), the sweep is processed with the constant-velocity model instead.
   double imu_wait = 0.3;
-  // [m], [rad] sigma of the lidar pose factor in the smoother (LIO-SAM correctionNoise 0.05 m / 0.05 rad; its
-  // degenerate-case noise, 1.0, is used when the match reports degenerate directions).
+  // [m], [rad] sigma of the lidar pose factor in the smoother (LIO-SAM correctionNoise 0.05 m / 0.05 rad) and
+  // the sigma [m or rad] added along each degenerate direction of a match, and on every axis of a failed one (LIO-SAM
+  // uses 1.0 on all axes when degenerate; here only the degenerate directions are left to the IMU).
   double lidar_sigma_position = 0.05;
   double lidar_sigma_rotation = 0.05;
-  double degenerate_sigma = 1.0;
+  double degenerate_sigma = 10.0;
   // Take each sweep's roll and pitch from the fixed-lag smoother (gravity-referenced through the IMU factors) and
   // keep the lidar's heading and position. Scan matching alone lets tilt drift (1.5 deg over the simulated garage
   // exit, 0.01 deg with this); LIO-SAM blends the IMU's roll/pitch in with imuRPYWeight for the same reason.
@@ -37,6 +38,10 @@ struct OdometryConfig {
   // match the sweep is deskewed again with its own estimated motion and re-matched, this many times (LOAM iterates
   // the same way).
   int deskew_refinements = 1;
+  // [sweeps] after this many consecutive degenerate matches the pose has drifted along the degenerate directions
+  // (IMU or motion model only), so the keyframes made before no longer agree with it: the local map restarts from
+  // the current sweep (a new submap; loop closure is what relates submaps). 0 disables.
+  int degenerate_restart_sweeps = 20;
   lidar::ScanLayoutConfig layout = lidar::ScanLayoutConfig::vlp16();
   lidar::FeatureExtractorConfig features;
   lidar::LocalMapConfig local_map;

@@ -154,6 +154,7 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .bind("degenerate_sigma", c.degenerate_sigma)
       .bind("gravity_roll_pitch", c.gravity_roll_pitch)
       .bind("deskew_refinements", c.deskew_refinements)
+      .bind("degenerate_restart_sweeps", c.degenerate_restart_sweeps)
       .nested("layout", [&](YamlSection& s) { bindLayout(s, c.layout, e); })
       .nested("features", [&](YamlSection& s) { bindFeatures(s, c.features, f); })
       .nested("local_map", [&](YamlSection& s) { bindLocalMap(s, c.local_map); })

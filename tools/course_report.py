@@ -1,0 +1,115 @@
+#!/usr/bin/python3
+"""Accuracy of a `drover run` on a simulated course, overall and per labelled segment.
+
+Usage: course_report.py DATASET_DIR RUN_DIR [--json OUT.json]
+
+DATASET_DIR is a `drover sim` folder (groundtruth.txt: T_world_imu, TUM; scenario.json: path length and labelled
+segments); RUN_DIR holds the run's trajectory.tum (T_world_imu, one pose per sweep). The estimate is put in the
+ground truth's frame by its first pose (no fitting, so drift shows in full). Figures:
+  end_error_m        |p_est(end) - p_gt(end)| after that first-pose alignment
+  drift_percent      end_error_m / ground-truth path length * 100
+  start_end_m        |p_est(end) - p_est(start)| (closed courses end where they start)
+  segments[]         per labelled segment: relative pose error between its first and last sweep,
+                     translation as % of the segment's path length and rotation in degrees
+Deliberately independent of Drover's C++ evaluator (numpy only), so the two can check each other.
+"""
+import argparse
+import json
+import sys
+
+import numpy as np
+
+
+def load_tum(path):
+    times, poses = [], []
+    with open(path) as f:
+        for line in f:
+            if not line.strip() or line.startswith("#"):
+                continue
+            v = [float(x) for x in line.split()]
+            times.append(round(v[0] * 1e9))
+            poses.append(pose_matrix(v[1:4], v[4:8]))
+    return np.array(times, dtype=np.int64), poses
+
+
+def pose_matrix(t, q_xyzw):
+    x, y, z, w = q_xyzw
+    n = np.sqrt(x * x + y * y + z * z + w * w)
+    x, y, z, w = x / n, y / n, z / n, w / n
+    T = np.eye(4)
+    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, 3] = t
+    return T
+
+
+def angle_deg(R):
+    return float(np.degrees(np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))))
+
+
+def path_length(poses):
+    p = np.array([T[:3, 3] for T in poses])
+    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) if len(p) > 1 else 0.0
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("dataset")
+    ap.add_argument("run")
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    gt_t, gt = load_tum(f"{a.dataset}/groundtruth.txt")
+    est_t, est = load_tum(f"{a.run}/trajectory.tum")
+    with open(f"{a.dataset}/scenario.json") as f:
+        scenario = json.load(f)
+    index = {t: i for i, t in enumerate(gt_t)}
+    pairs = [(i, index[t]) for i, t in enumerate(est_t) if t in index]
+    if len(pairs) < 2:
+        sys.exit(f"error: fewer than 2 estimate poses match ground-truth stamps in {a.run}")
+    gt_m = [gt[j] for _, j in pairs]
+    est_m = [est[i] for i, _ in pairs]
+    times = np.array([est_t[i] for i, _ in pairs])
+    align = gt_m[0] @ np.linalg.inv(est_m[0])
+    est_a = [align @ T for T in est_m]
+    errors = np.array([np.linalg.norm(E[:3, 3] - G[:3, 3]) for E, G in zip(est_a, gt_m)])
+    length = path_length(gt_m)
+    out = {
+        "scenario": scenario.get("scenario"),
+        "sweeps": len(pairs),
+        "path_length_m": length,
+        "end_error_m": float(errors[-1]),
+        "drift_percent": float(100 * errors[-1] / length) if length > 0 else 0.0,
+        "max_error_m": float(errors.max()),
+        "rmse_first_pose_aligned_m": float(np.sqrt(np.mean(errors ** 2))),
+        "start_end_m": float(np.linalg.norm(est_a[-1][:3, 3] - est_a[0][:3, 3])),
+        "segments": [],
+    }
+    for seg in scenario.get("segments", []):
+        sel = np.nonzero((times >= seg["start_ns"]) & (times <= seg["end_ns"]))[0]
+        if len(sel) < 2:
+            continue
+        i0, i1 = sel[0], sel[-1]
+        rel_gt = np.linalg.inv(gt_m[i0]) @ gt_m[i1]
+        rel_est = np.linalg.inv(est_a[i0]) @ est_a[i1]
+        seg_len = path_length(gt_m[i0:i1 + 1])
+        t_err = float(np.linalg.norm(rel_est[:3, 3] - rel_gt[:3, 3]))
+        out["segments"].append({
+            "condition": seg["condition"], "start_s": seg["start_ns"] * 1e-9, "end_s": seg["end_ns"] * 1e-9,
+            "length_m": seg_len, "translation_error_m": t_err,
+            "translation_error_percent": 100 * t_err / seg_len if seg_len > 0 else 0.0,
+            "rotation_error_deg": angle_deg(rel_gt[:3, :3].T @ rel_est[:3, :3]),
+        })
+    print(f"{out['scenario']}: {out['sweeps']} sweeps, {length:.1f} m; end error {out['end_error_m']:.3f} m "
+          f"({out['drift_percent']:.2f} %), max {out['max_error_m']:.3f} m, start-end {out['start_end_m']:.3f} m")
+    for s in out["segments"]:
+        print(f"  {s['condition']:>13} {s['start_s']:7.1f}-{s['end_s']:7.1f} s {s['length_m']:7.1f} m: "
+              f"{s['translation_error_m']:.3f} m ({s['translation_error_percent']:.2f} %), "
+              f"{s['rotation_error_deg']:.2f} deg")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(out, f, indent=2)
+
+
+if __name__ == "__main__":
+    main()
