@@ -12,6 +12,8 @@ import sys
 
 BEGIN, END = "<!-- micro:begin -->", "<!-- micro:end -->"
 COUNTERS = ("bytes_per_second", "items_per_second", "msgs/s", "points/s")
+# Plain figures (not rates) shown as "name value".
+FIGURES = ("real_time_factor", "sim_s_per_wall_s", "ms_per_sweep", "points_per_sweep")
 
 
 def human(value, unit):
@@ -31,6 +33,7 @@ def rows(out_dir):
                 if key in b:
                     unit = "B/s" if key == "bytes_per_second" else ("/s" if key == "items_per_second" else key[:-2] + "/s")
                     rates.append(human(b[key], unit))
+            rates += [f"{key} {b[key]:.3g}" for key in FIGURES if key in b]
             yield (os.path.basename(path)[:-5], b["name"], f"{b['real_time']:.3g} {b['time_unit']}", ", ".join(rates))
 
 
