@@ -18,8 +18,8 @@ struct LidarPoint {
 struct LidarScan {
   Time t = 0;               // [ns] start of the sweep
   Time t_end = 0;           // [ns] end of the sweep (== t when unknown)
-  bool has_time = false;    // per-point time_offset was measured (not inferred)
-  bool has_ring = false;    // per-point ring was measured (not inferred)
+  bool has_time = false;    // per-point time_offset is valid: measured by the lidar, or set by lidar::inferTimes()
+  bool has_ring = false;    // per-point ring is valid: measured by the lidar, or set by lidar::inferRings()
   std::vector<LidarPoint> points;
 };
 
