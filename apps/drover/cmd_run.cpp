@@ -102,6 +102,8 @@ void runOdometry(const RunOptions& o) {
     if (since < o.start) continue;
     if (o.duration > 0 && since > o.start + o.duration) break;
     keep(odometry.process(*m), record);
+    const std::vector<std::string>& notices = odometry.stats().notices;
+    for (; record.notices_shown < notices.size(); ++record.notices_shown) spdlog::warn("{}", notices[record.notices_shown]);
     progress.update(record.scans.size(), since - o.start);
   }
   keep(odometry.finish(), record);

@@ -98,6 +98,7 @@ Json statsJson(const pipeline::OdometryStats& s) {
   j["degenerate_times_s"] = deg;
   j["reset_times_s"] = resets;
   j["map_restart_times_s"] = restarts;
+  j["notices"] = s.notices;
   return j;
 }
 

@@ -25,6 +25,7 @@ struct RunRecord {
   std::vector<pipeline::ScanOutcome> scans;
   double wall_s = 0;  // [s] wall time of the odometry loop (reading included)
   double data_s = 0;  // [s] time spanned by the processed sweeps
+  std::size_t notices_shown = 0;  // OdometryStats::notices already printed
 };
 
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be

@@ -33,13 +33,10 @@ struct LidarOdometry::Impl {
   ImuFusion fusion;
   std::deque<LidarScan> pending;  // sweeps waiting for the IMU to cover their end (time order)
   Trajectory trajectory;          // T_world_lidar per processed sweep
-  std::vector<Time> keyframe_times;
   Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
   OdometryStats stats;
-  Time last_scan_t = 0;
   int degenerate_run = 0;               // consecutive degenerate sweeps
   std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
-  bool have_scan = false;
 
   Impl(const OdometryConfig& c, const Calibration& calib)
       : config(c),
@@ -60,6 +57,9 @@ struct LidarOdometry::Impl {
                                      ScanOutcome& out) const;
   void match(const lidar::FeatureSet& features, const Eigen::Isometry3d& guess, ScanOutcome& out);
   void countMatch(ScanOutcome& out);
+  void notice(std::string line) {
+    if (stats.notices.size() < OdometryStats::kMaxNotices) stats.notices.push_back(std::move(line));
+  }
   void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
 };
 
@@ -108,9 +108,11 @@ std::vector<ScanOutcome> LidarOdometry::Impl::onScan(LidarScan scan) {
   ++stats.scans_in;
   scan.t += calibration.lidar_time_offset;
   scan.t_end += calibration.lidar_time_offset;
-  const Time last = !pending.empty() ? pending.back().t : (have_scan ? last_scan_t : scan.t - 1);
+  const Time last = !pending.empty() ? pending.back().t : (!trajectory.empty() ? trajectory.back().t : scan.t - 1);
   if (scan.t <= last) {
     ++stats.scans_skipped_time;
+    notice(fmt::format("sweep at {:.6f} s skipped: its stamp is not after the previous sweep's ({:.6f} s)",
+                       toSeconds(scan.t), toSeconds(last)));
     return {};
   }
   pending.push_back(std::move(scan));
@@ -178,8 +180,6 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
 
   keyframe(features, out);
   trajectory.push_back({scan.t, out.T_world_lidar});
-  last_scan_t = scan.t;
-  have_scan = true;
   ++stats.scans_processed;
   stats.imu_initialized = fusion.initialized();
   stats.imu_init = fusion.initNote();
@@ -195,6 +195,8 @@ bool LidarOdometry::Impl::preprocess(LidarScan& scan, ScanOutcome& out) {
   out.points = scan.points.size();
   if (static_cast<int>(scan.points.size()) < config.min_points) {
     ++stats.scans_skipped_empty;
+    notice(fmt::format("sweep at {:.6f} s skipped: {} valid points (fewer than min_points = {})", toSeconds(scan.t),
+                       scan.points.size(), config.min_points));
     return false;
   }
   if (!scan.has_time) lidar::inferTimes(scan, config.layout);

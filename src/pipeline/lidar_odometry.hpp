@@ -68,6 +68,9 @@ struct OdometryStats {
   std::vector<Time> degenerate_times;    // [ns] sweep times of degenerate matches
   std::vector<Time> reset_times;         // [ns] sweep times of smoother resets
   std::vector<Time> map_restart_times;   // [ns] sweeps where a long degenerate stretch restarted the local map
+  // One line per skipped sweep (the first kMaxNotices; the counters above count them all), for the caller to show.
+  static constexpr std::size_t kMaxNotices = 200;
+  std::vector<std::string> notices;
 };
 
 class LidarOdometry {

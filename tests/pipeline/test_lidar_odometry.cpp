@@ -140,6 +140,8 @@ TEST(LidarOdometry, EmptyScanIsSkippedWithoutLosingTrack) {
                       }),
                       simConfig(true));
   EXPECT_EQ(r.stats.scans_skipped_empty, 1u);
+  ASSERT_EQ(r.stats.notices.size(), 1u);
+  EXPECT_NE(r.stats.notices[0].find("valid points"), std::string::npos) << r.stats.notices[0];
   EXPECT_EQ(r.imu_poses.size(), sweeps() - 1);
   EXPECT_LT(r.ape_rmse, 0.05);
 }
@@ -159,6 +161,7 @@ TEST(LidarOdometry, DuplicateAndBackwardsSweepStampsAreSkipped) {
   }
   const OdometryRun r = runOn(stream, simConfig(true));
   EXPECT_EQ(r.stats.scans_skipped_time, 2 * (sweeps() / 20));
+  EXPECT_EQ(r.stats.notices.size(), r.stats.scans_skipped_time);
   EXPECT_EQ(r.imu_poses.size(), sweeps());
   EXPECT_LT(r.ape_rmse, 0.05);
 }
