@@ -278,13 +278,18 @@ void LidarOdometry::Impl::countMatch(ScanOutcome& out) {
 
 void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcome& out) {
   const bool first = map.size() == 0;
+  const int n = config.degenerate_restart_sweeps;
+  const bool was_long = n > 0 && degenerate_run >= n;
   degenerate_run = out.degenerate ? degenerate_run + 1 : 0;
-  const bool restart = config.degenerate_restart_sweeps > 0 && degenerate_run == config.degenerate_restart_sweeps;
+  // Restart when a long degenerate stretch begins (older keyframes disagree with the drifting pose) and again when
+  // it ends (the stretch's own keyframes are stretched or squeezed along the degenerate direction).
+  const bool restart = n > 0 && (degenerate_run == n || (was_long && degenerate_run == 0));
   if (restart) {
     map_first_keyframe = map.size();
     stats.map_restart_times.push_back(out.t);
-    out.warning += std::string(out.warning.empty() ? "" : "; ") + fmt::format(
-        "{} degenerate sweeps in a row: local map restarted (new submap)", degenerate_run);
+    out.warning += std::string(out.warning.empty() ? "" : "; ") +
+                   (degenerate_run == n ? fmt::format("{} degenerate sweeps in a row: local map restarted", n)
+                                        : std::string("end of a degenerate stretch: local map restarted"));
   }
   if (!first && !restart && !policy.isKeyframe(T_world_lastkf, out.T_world_lidar)) return;
 
