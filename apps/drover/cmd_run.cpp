@@ -64,7 +64,8 @@ io::DatasetOptions datasetOptions(const RunOptions& o) {
 }
 
 void checkOptions(const RunOptions& o) {
-  if (!std::isfinite(o.start) || o.start < 0) throw std::invalid_argument(fmt::format("--start must be >= 0 s, got {}", o.start));
+  if (!std::isfinite(o.start) || o.start < 0)
+    throw std::invalid_argument(fmt::format("--start must be >= 0 s, got {}", o.start));
   if (!std::isfinite(o.duration) || o.duration < 0)
     throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
   if (!fs::exists(o.dataset)) throw std::invalid_argument("dataset " + o.dataset + " not found");
@@ -103,7 +104,8 @@ void runOdometry(const RunOptions& o) {
     if (o.duration > 0 && since > o.start + o.duration) break;
     keep(odometry.process(*m), record);
     const std::vector<std::string>& notices = odometry.stats().notices;
-    for (; record.notices_shown < notices.size(); ++record.notices_shown) spdlog::warn("{}", notices[record.notices_shown]);
+    for (; record.notices_shown < notices.size(); ++record.notices_shown)
+      spdlog::warn("{}", notices[record.notices_shown]);
     progress.update(record.scans.size(), since - o.start);
   }
   keep(odometry.finish(), record);
