@@ -18,13 +18,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-Json readJson(const fs::path& p) {
-  std::ifstream in(p);
-  EXPECT_TRUE(in.good()) << p;
-  return Json::parse(in);
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
 
 std::size_t lines(const fs::path& p) {

@@ -1,9 +1,14 @@
 #pragma once
 // Runs the drover binary for CLI tests: exit code and combined output.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
 #include <array>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 #include <string>
-#include <sys/wait.h>
 
 namespace drover::test {
 
@@ -23,5 +28,14 @@ inline CliResult runDrover(const std::string& args) {
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
 }
+
+// A JSON file the command wrote (a failed expectation when it cannot be opened).
+inline nlohmann::json readJson(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  EXPECT_TRUE(in.good()) << p;
+  return nlohmann::json::parse(in);
+}
+
+inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 }  // namespace drover::test
