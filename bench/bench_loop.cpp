@@ -32,6 +32,14 @@ void BM_ScanContextDescriptorKitti(benchmark::State& state) {
 }
 BENCHMARK(BM_ScanContextDescriptorKitti)->Unit(benchmark::kMillisecond);
 
+// The query side of the lateral augmentation: 9 descriptors (3 x 3 virtual positions, 2 m apart).
+void BM_AugmentedScanContextKitti(benchmark::State& state) {
+  const auto* c = cloud("001500.bin");
+  if (!c) return state.SkipWithError("../shared/data/kitti/revisit_08 not found");
+  for (auto _ : state) benchmark::DoNotOptimize(loop::makeAugmentedScanContext(*c, {}).descriptors.data());
+}
+BENCHMARK(BM_AugmentedScanContextKitti)->Unit(benchmark::kMillisecond);
+
 void shiftSearch(benchmark::State& state, bool narrowed) {
   const auto *a = cloud("000720.bin"), *b = cloud("001500.bin");
   if (!a || !b) return state.SkipWithError("../shared/data/kitti/revisit_08 not found");

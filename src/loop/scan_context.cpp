@@ -1,6 +1,8 @@
 #include "loop/scan_context.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -24,31 +26,63 @@ std::string ScanContextConfig::validate() const {
   if (!std::isfinite(sensor_height)) return "sensor_height must be finite";
   if (!std::isfinite(threshold) || threshold <= 0 || threshold > 2) return "threshold must be in (0, 2]";
   if (search_radius < 0) return "search_radius must be >= 0";
+  if (!std::isfinite(lateral_step) || lateral_step <= 0) return "lateral_step must be finite and > 0 m";
+  if (lateral_steps < 0 || lateral_steps > 5) return "lateral_steps must be in [0, 5]";
   return {};
 }
 
-ScanContext makeScanContext(const lidar::PointCloud& cloud, const ScanContextConfig& config) {
-  if (std::string e = config.validate(); !e.empty()) throw std::invalid_argument("scan context config: " + e);
+namespace {
+
+// The descriptor of the points p - origin (origin: the sensor's real or virtual x-y position [m]).
+ScanContext describe(const lidar::PointCloud& cloud, const ScanContextConfig& config, const Eigen::Vector2f& origin) {
   ScanContext sc;
   sc.image = Eigen::MatrixXf::Zero(config.rings, config.sectors);
   sc.occupied = Eigen::MatrixXf::Zero(config.rings, config.sectors);
-  const double ring_width = config.max_radius / config.rings, sector_width = kTwoPi / config.sectors;
+  // Float arithmetic throughout: 120k points per scan, and bin edges need no double precision.
+  const float max_r = static_cast<float>(config.max_radius), max_r2 = max_r * max_r;
+  const float rings_per_m = static_cast<float>(config.rings) / max_r;
+  const float sectors_per_rad = static_cast<float>(config.sectors / kTwoPi), two_pi = static_cast<float>(kTwoPi);
+  const float lift = static_cast<float>(config.sensor_height);
   for (const Eigen::Vector3f& p : cloud) {
-    if (!p.allFinite()) continue;
-    const double r = std::hypot(double(p.x()), double(p.y()));
-    if (r >= config.max_radius || r <= 0) continue;
-    double theta = std::atan2(double(p.y()), double(p.x()));
-    if (theta < 0) theta += kTwoPi;
-    const int ring = std::min(static_cast<int>(r / ring_width), config.rings - 1);
-    const int sector = std::min(static_cast<int>(theta / sector_width), config.sectors - 1);
-    const float h = static_cast<float>(p.z() + config.sensor_height);
+    const float x = p.x() - origin.x(), y = p.y() - origin.y();
+    const float r2 = x * x + y * y;
+    if (!(r2 < max_r2) || r2 <= 0.0f || !std::isfinite(p.z())) continue;  // also drops NaN x/y
+    float theta = std::atan2(y, x);
+    if (theta < 0) theta += two_pi;
+    const int ring = std::min(static_cast<int>(std::sqrt(r2) * rings_per_m), config.rings - 1);
+    const int sector = std::min(static_cast<int>(theta * sectors_per_rad), config.sectors - 1);
+    const float h = p.z() + lift;
     float& cell = sc.image(ring, sector);
-    if (sc.occupied(ring, sector) == 0.0f || h > cell) cell = h;
-    sc.occupied(ring, sector) = 1.0f;
+    float& occ = sc.occupied(ring, sector);
+    if (occ == 0.0f || h > cell) cell = h;
+    occ = 1.0f;
   }
   sc.ring_key = sc.image.rowwise().mean();
   sc.sector_key = sc.image.colwise().mean().transpose();
   return sc;
+}
+
+void requireValid(const ScanContextConfig& config) {
+  if (std::string e = config.validate(); !e.empty()) throw std::invalid_argument("scan context config: " + e);
+}
+
+}  // namespace
+
+ScanContext makeScanContext(const lidar::PointCloud& cloud, const ScanContextConfig& config) {
+  requireValid(config);
+  return describe(cloud, config, Eigen::Vector2f::Zero());
+}
+
+AugmentedScanContext makeAugmentedScanContext(const lidar::PointCloud& cloud, const ScanContextConfig& config) {
+  requireValid(config);
+  AugmentedScanContext out;
+  out.offsets.emplace_back(0.0f, 0.0f);  // the real position first
+  const int k = config.lateral_steps;
+  for (int i = -k; i <= k; ++i)
+    for (int j = -k; j <= k; ++j)
+      if (i != 0 || j != 0) out.offsets.emplace_back(float(i * config.lateral_step), float(j * config.lateral_step));
+  for (const Eigen::Vector2f& o : out.offsets) out.descriptors.push_back(describe(cloud, config, o));
+  return out;
 }
 
 double columnDistance(const ScanContext& a, const ScanContext& b, int shift) {
@@ -108,6 +142,47 @@ ShiftMatch narrowedShiftSearch(const ScanContext& a, const ScanContext& b, std::
     return m;
   }
   return fullShiftSearch(a, b);
+}
+
+int sectorKeyShift(const ScanContext& a, const ScanContext& b) {
+  requireSameShape(a, b);
+  const int sectors = static_cast<int>(a.image.cols());
+  int best_shift = 0;
+  float best = std::numeric_limits<float>::infinity();
+  for (int n = 0; n < sectors; ++n) {
+    float l1 = 0;
+    for (int j = 0; j < sectors; ++j) l1 += std::abs(a.sector_key(j) - b.sector_key(wrapShift(j - n, sectors)));
+    if (l1 < best) {
+      best = l1;
+      best_shift = n;
+    }
+  }
+  return best_shift;
+}
+
+ShiftMatch sectorKeyShiftSearch(const ScanContext& a, const ScanContext& b, const ScanContextConfig& config) {
+  requireSameShape(a, b);
+  const int sectors = static_cast<int>(a.image.cols());
+  const int width = std::min(2 * config.search_radius + 1, sectors);
+  ShiftMatch m = searchShifts(a, b, sectorKeyShift(a, b) - config.search_radius, width);
+  m.narrowed = true;
+  return m;
+}
+
+AugmentedMatch augmentedShiftSearch(const ScanContext& a, const AugmentedScanContext& b,
+                                    std::optional<double> yaw_prior, const ScanContextConfig& config) {
+  if (b.descriptors.empty() || b.descriptors.size() != b.offsets.size())
+    throw std::invalid_argument("augmented scan context has no descriptors or mismatched offsets");
+  AugmentedMatch best;
+  for (std::size_t i = 0; i < b.descriptors.size(); ++i) {
+    const ShiftMatch m = narrowedShiftSearch(a, b.descriptors[i], yaw_prior, config);
+    if (i == 0 || m.distance < best.match.distance) {
+      best.match = m;
+      best.index = static_cast<int>(i);
+      best.offset = b.offsets[i];
+    }
+  }
+  return best;
 }
 
 double yawFromShift(int shift, int sectors) {
