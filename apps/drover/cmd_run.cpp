@@ -84,7 +84,6 @@ void runOdometry(const RunOptions& o) {
   pipeline::OdometryConfig config = o.config.empty() ? pipeline::OdometryConfig{} : io::loadOdometryConfig(o.config);
   if (o.no_imu) config.use_imu = false;
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, datasetOptions(o));
-  fs::create_directories(o.out);
   const io::GroundTruth& gt = reader->groundTruth();
   pipeline::LidarOdometry odometry(config, reader->calibration());
   spdlog::info("drover run: {} ({}), {} -> {}", reader->describe(), o.format,
@@ -115,6 +114,7 @@ void runOdometry(const RunOptions& o) {
                                 ": drover run needs a lidar (the visual-inertial subsystem is not built yet)");
   record.wall_s = progress.wallSeconds();
   record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
+  fs::create_directories(o.out);  // only now: a run that fails on its data leaves no folder behind
   RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt};
   writeRunFolder(context, odometry, record);
 }

@@ -132,7 +132,7 @@ Json evaluate(const RunContext& c, const Trajectory& est) {
   Json j;
   try {
     const eval::ApeResult r = eval::computeApe(c.ground_truth.poses, est, options);
-    fmt::print("{}\n\n{}\n", apeTitle(r), statisticsTable(r.stats));
+    if (spdlog::should_log(spdlog::level::info)) fmt::print("{}\n\n{}\n", apeTitle(r), statisticsTable(r.stats));
     j = statisticsJson(r.stats);
     j["pairs"] = r.pairs;
     options.relation = eval::PoseRelation::kAngleDeg;

@@ -11,7 +11,8 @@
 //              equidistant, distortion_coeffs: [k1, k2, p1, p2(, k3)] or [k1, k2, k3, k4]}
 //     lidar_time_offset, camera_time_offset: [s], t_imu = t_sensor + offset
 //
-// Other top-level sections belong to other modules and are left alone. Inside these two sections an unknown
+// The other top-level sections (`sim:`, `odometry:`) belong to other modules and are read by them; any other
+// top-level name is an error naming its line (a misspelt section must not silently fall back to defaults). Inside these two sections an unknown
 // key is an error naming it (a typo must not silently fall back to a default), as is a value of the wrong type.
 #include <Eigen/Geometry>
 #include <string>

@@ -2,6 +2,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -51,6 +52,20 @@ YamlSection& YamlSection::bind(const std::string& key, bool& value) {
 
 YamlSection& YamlSection::bind(const std::string& key, std::string& value) {
   setters_[key] = [this, &value](const YAML::Node& n, const std::string& rec) { value = scalarOf(n, file_, rec); };
+  return *this;
+}
+
+YamlSection& YamlSection::bindChoice(const std::string& key, std::string& value, std::vector<std::string> allowed) {
+  setters_[key] = [this, &value, allowed = std::move(allowed)](const YAML::Node& n, const std::string& rec) {
+    const std::string v = scalarOf(n, file_, rec);
+    if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) {
+      std::string list;  // "a, b or c"
+      for (std::size_t i = 0; i < allowed.size(); ++i)
+        list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
+      fail(file_, rec, "expected " + list + ", got '" + v + "'");
+    }
+    value = v;
+  };
   return *this;
 }
 

@@ -6,6 +6,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace YAML {
 class Node;
@@ -21,6 +22,8 @@ class YamlSection {
   YamlSection& bind(const std::string& key, int& value);
   YamlSection& bind(const std::string& key, bool& value);
   YamlSection& bind(const std::string& key, std::string& value);
+  // A string that must be one of `allowed`; otherwise an IoError naming the line, the key and the allowed values.
+  YamlSection& bindChoice(const std::string& key, std::string& value, std::vector<std::string> allowed);
   // A nested section, read by `read` (which binds its own keys on the YamlSection it is given).
   YamlSection& nested(const std::string& key, std::function<void(YamlSection&)> read);
 

@@ -98,13 +98,20 @@ TEST(Config, DatasetFilesSelectTheirSensors) {
 
 TEST(Config, AbsentSectionsAndKeysKeepTheDefaults) {
   const DatasetOptions defaults;
-  for (const char* yaml : {"", "lidar:\n  voxel_size: 0.5\n", "dataset:\ncalibration:\n"}) {
+  for (const char* yaml : {"", "sim:\n  noise: false\nodometry:\n  use_imu: false\n", "dataset:\ncalibration:\n"}) {
     const DatasetOptions o = load(yaml);
     EXPECT_EQ(o.lidar_topic, defaults.lidar_topic) << yaml;
     EXPECT_EQ(o.kitti_camera, defaults.kitti_camera) << yaml;
     EXPECT_EQ(o.load_images, defaults.load_images) << yaml;
     EXPECT_TRUE(o.calibration.T_imu_cam.isApprox(Eigen::Isometry3d::Identity())) << yaml;
   }
+}
+
+TEST(Config, UnknownTopLevelSectionIsNamedWithItsLine) {
+  const std::string e = errorOf("dataset:\n  load_imu: true\nodometri:\n  use_imu: false\n");
+  EXPECT_NE(e.find("line 3"), std::string::npos) << e;
+  EXPECT_NE(e.find("'odometri'"), std::string::npos) << e;
+  EXPECT_NE(e.find("odometry"), std::string::npos) << e;  // the known sections are listed
 }
 
 TEST(Config, ReadsEveryKey) {

@@ -23,8 +23,8 @@ void bindLayout(YamlSection& s, lidar::ScanLayoutConfig& c, EnumStrings& e) {
       .bind("vertical_fov_max_deg", c.vertical_fov_max_deg)
       .bind("columns", c.columns)
       .bind("scan_period", c.scan_period)
-      .bind("spin", e.spin)
-      .bind("ring_source", e.ring_source)
+      .bindChoice("spin", e.spin, {"ccw", "cw"})
+      .bindChoice("ring_source", e.ring_source, {"elevation", "order"})
       .bind("order_top_down", c.order_top_down)
       .bind("seam_tolerance_deg", c.seam_tolerance_deg)
       .bind("min_range", c.min_range)
@@ -73,7 +73,7 @@ void bindMatcher(YamlSection& s, lidar::ScanMatcherConfig& c, EnumStrings& e) {
       .bind("max_neighbor_distance", c.max_neighbor_distance)
       .bind("edge_eigen_ratio", c.edge_eigen_ratio)
       .bind("plane_tolerance", c.plane_tolerance)
-      .bind("kernel", e.kernel)
+      .bindChoice("kernel", e.kernel, {"lio-sam", "huber"})
       .bind("min_weight", c.min_weight)
       .bind("huber_delta", c.huber_delta)
       .bind("degeneracy_threshold", c.degeneracy_threshold)
@@ -103,28 +103,12 @@ void bindSmoother(YamlSection& s, backend::FixedLagSmootherConfig& c) {
       .bind("max_bias", c.max_bias);
 }
 
-void applyEnums(const EnumStrings& e, pipeline::OdometryConfig& c, const std::string& file) {
-  if (e.spin == "ccw") {
-    c.layout.spin = lidar::SpinDirection::kCounterClockwise;
-  } else if (e.spin == "cw") {
-    c.layout.spin = lidar::SpinDirection::kClockwise;
-  } else {
-    fail(file, "key 'odometry.layout.spin'", "expected ccw or cw, got '" + e.spin + "'");
-  }
-  if (e.ring_source == "elevation") {
-    c.layout.ring_source = lidar::RingSource::kElevation;
-  } else if (e.ring_source == "order") {
-    c.layout.ring_source = lidar::RingSource::kOrder;
-  } else if (!e.ring_source.empty()) {
-    fail(file, "key 'odometry.layout.ring_source'", "expected elevation or order, got '" + e.ring_source + "'");
-  }
-  if (e.kernel == "lio-sam") {
-    c.matcher.kernel = lidar::RobustKernel::kLioSam;
-  } else if (e.kernel == "huber") {
-    c.matcher.kernel = lidar::RobustKernel::kHuber;
-  } else {
-    fail(file, "key 'odometry.matcher.kernel'", "expected lio-sam or huber, got '" + e.kernel + "'");
-  }
+// The binder has already checked the values (bindChoice), with their lines.
+void applyEnums(const EnumStrings& e, pipeline::OdometryConfig& c) {
+  c.layout.spin = e.spin == "cw" ? lidar::SpinDirection::kClockwise : lidar::SpinDirection::kCounterClockwise;
+  if (e.ring_source == "elevation") c.layout.ring_source = lidar::RingSource::kElevation;
+  if (e.ring_source == "order") c.layout.ring_source = lidar::RingSource::kOrder;
+  c.matcher.kernel = e.kernel == "huber" ? lidar::RobustKernel::kHuber : lidar::RobustKernel::kLioSam;
 }
 
 }  // namespace
@@ -165,7 +149,7 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .nested("imu", [&](YamlSection& s) { bindImu(s, c.preintegration); })
       .nested("smoother", [&](YamlSection& s) { bindSmoother(s, c.smoother); });
   top.apply(root["odometry"]);
-  applyEnums(e, c, yaml_path);
+  applyEnums(e, c);
   c.features.edge_threshold = static_cast<float>(f.edge_threshold);
   c.features.surf_threshold = static_cast<float>(f.surf_threshold);
   c.features.occlusion_depth_gap = static_cast<float>(f.occlusion_depth_gap);
