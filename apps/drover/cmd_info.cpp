@@ -114,18 +114,6 @@ Json rowMajor(const Eigen::Isometry3d& T) {
   return j;
 }
 
-const char* distortionName(DistortionModel m) {
-  switch (m) {
-    case DistortionModel::kRadialTangential:
-      return "radial-tangential";
-    case DistortionModel::kEquidistant:
-      return "equidistant";
-    case DistortionModel::kNone:
-      break;
-  }
-  return "none";
-}
-
 Json calibrationJson(const Calibration& c) {
   Json j;
   j["T_imu_lidar"] = rowMajor(c.T_imu_lidar);
@@ -133,7 +121,7 @@ Json calibrationJson(const Calibration& c) {
   const CameraIntrinsics& k = c.camera;
   j["camera"] = {{"width", k.width}, {"height", k.height}, {"fx", k.fx},
                  {"fy", k.fy},       {"cx", k.cx},         {"cy", k.cy},
-                 {"distortion_model", distortionName(k.distortion)}, {"distortion_coeffs", k.distortion_coeffs}};
+                 {"distortion_model", distortionModelName(k.distortion)}, {"distortion_coeffs", k.distortion_coeffs}};
   j["lidar_time_offset_s"] = toSeconds(c.lidar_time_offset);
   j["camera_time_offset_s"] = toSeconds(c.camera_time_offset);
   return j;
@@ -199,7 +187,7 @@ std::string summaryText(const Json& j, const Summary& s, const io::Reader& reade
   out += "Calibration:\n" + matrixLines("T_imu_lidar", c.T_imu_lidar) + matrixLines("T_imu_cam", c.T_imu_cam);
   const CameraIntrinsics& k = c.camera;
   out += fmt::format("  camera: {}x{} px, fx {} fy {} cx {} cy {} [px], {} [{}]\n", k.width, k.height, k.fx, k.fy,
-                     k.cx, k.cy, distortionName(k.distortion), fmt::join(k.distortion_coeffs, ", "));
+                     k.cx, k.cy, distortionModelName(k.distortion), fmt::join(k.distortion_coeffs, ", "));
   out += fmt::format("  time offsets: lidar {} s, camera {} s\n", io::formatSeconds(c.lidar_time_offset),
                      io::formatSeconds(c.camera_time_offset));
   const Json& g = j["ground_truth"];

@@ -183,4 +183,7 @@ SimDatasetDescription readSimDescription(const std::string& dir);
 // lazily. options.load_imu / load_lidar / load_images are honoured.
 std::unique_ptr<Reader> openSimDataset(const std::string& dir, const DatasetOptions& options);
 
+// File name of record `index` in lidar/ or camera/: six digits and the extension ("000042.bin").
+std::string simFileName(std::size_t index, const char* extension);
+
 }  // namespace drover::io

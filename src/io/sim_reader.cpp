@@ -21,12 +21,6 @@ namespace fs = std::filesystem;
 
 static_assert(std::endian::native == std::endian::little, "the .bin records are read in host order");
 
-std::string indexName(std::size_t index, const char* extension) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%06zu%s", index, extension);
-  return buf;
-}
-
 // ---- calibration.yaml ------------------------------------------------------------------------------------------
 
 // Typed access to required keys of one YAML map, naming file, line and "section.key" in every error.
@@ -255,7 +249,7 @@ std::vector<IndexEntry> readIndex(const fs::path& folder, bool has_end, const ch
     e.t_end = has_end ? parseInt64(f[2], csv, record) : e.t;
     if (e.t_end < e.t) fail(csv, record, "sweep ends before it starts");
     if (!entries.empty()) requireIncreasingTime(entries.back().t, e.t, csv, record);
-    e.path = (folder / indexName(entries.size(), extension)).string();
+    e.path = (folder / simFileName(entries.size(), extension)).string();
     e.record = "listed in " + csv + " " + record;
     entries.push_back(std::move(e));
   }

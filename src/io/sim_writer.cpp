@@ -19,24 +19,6 @@ namespace fs = std::filesystem;
 
 static_assert(std::endian::native == std::endian::little, "the .bin records are written in host order");
 
-std::string indexName(std::size_t index, const char* extension) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%06zu%s", index, extension);
-  return buf;
-}
-
-const char* distortionName(DistortionModel m) {
-  switch (m) {
-    case DistortionModel::kRadialTangential:
-      return "radial-tangential";
-    case DistortionModel::kEquidistant:
-      return "equidistant";
-    case DistortionModel::kNone:
-      break;
-  }
-  return "none";
-}
-
 std::string numberList(const std::vector<double>& values) {
   std::string s = "[";
   for (std::size_t i = 0; i < values.size(); ++i) s += (i ? ", " : "") + formatDouble(values[i]);
@@ -65,7 +47,7 @@ std::string calibrationYaml(const SimDatasetDescription& d) {
   y += "    height: " + std::to_string(k.height) + "  # [px]\n";
   y += "    fx: " + formatDouble(k.fx) + "  # [px]\n    fy: " + formatDouble(k.fy) + "  # [px]\n";
   y += "    cx: " + formatDouble(k.cx) + "  # [px]\n    cy: " + formatDouble(k.cy) + "  # [px]\n";
-  y += std::string("    distortion_model: ") + distortionName(k.distortion) + "\n";
+  y += std::string("    distortion_model: ") + distortionModelName(k.distortion) + "\n";
   y += "    distortion_coeffs: " + numberList(k.distortion_coeffs) + "\n";
   y += "sensors:\n";
   y += "  lidar:\n    model: " + s.lidar_model + "\n    rings: " + std::to_string(s.lidar_rings) +
@@ -128,6 +110,12 @@ void writeBinary(const fs::path& path, const std::string& bytes) {
 }
 
 }  // namespace
+
+std::string simFileName(std::size_t index, const char* extension) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%06zu%s", index, extension);
+  return buf;
+}
 
 SimDatasetWriter::SimDatasetWriter(const std::string& dir, const SimDatasetDescription& description,
                                    const SimWriterOptions& options)
@@ -209,7 +197,7 @@ void SimDatasetWriter::addScan(const LidarScan& scan) {
                                   std::to_string(description_.sensors.lidar_rings));
     packPoint(p, static_cast<std::uint32_t>(offset_ns), bytes.data() + i * kSimPointBytes);
   }
-  writeBinary(partial_ / "lidar" / indexName(counts_.lidar, ".bin"), bytes);
+  writeBinary(partial_ / "lidar" / simFileName(counts_.lidar, ".bin"), bytes);
   lidar_csv_ += std::to_string(counts_.lidar) + "," + std::to_string(scan.t) + "," + std::to_string(scan.t_end) + "\n";
   last_lidar_ = scan.t;
   ++counts_.lidar;
@@ -227,7 +215,7 @@ void SimDatasetWriter::addFrame(CameraFrame&& frame) {
                                 std::to_string(img.channels) + ", calibration says " + std::to_string(k.width) + "x" +
                                 std::to_string(k.height) + "x" + std::to_string(description_.sensors.camera_channels));
   camera_csv_ += std::to_string(counts_.camera) + "," + std::to_string(frame.t) + "\n";
-  PendingImage pending{partial_ / "camera" / indexName(counts_.camera, ".png"), std::move(frame.image)};
+  PendingImage pending{partial_ / "camera" / simFileName(counts_.camera, ".png"), std::move(frame.image)};
   {
     std::unique_lock lock(mutex_);
     cv_.wait(lock, [&] { return queue_.size() < options_.max_queued_images || !encoder_error_.empty(); });

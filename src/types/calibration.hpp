@@ -9,6 +9,19 @@ namespace drover {
 
 enum class DistortionModel { kNone, kRadialTangential, kEquidistant };
 
+// The name configs and dataset files use: "none", "radial-tangential", "equidistant".
+inline const char* distortionModelName(DistortionModel m) {
+  switch (m) {
+    case DistortionModel::kRadialTangential:
+      return "radial-tangential";
+    case DistortionModel::kEquidistant:
+      return "equidistant";
+    case DistortionModel::kNone:
+      break;
+  }
+  return "none";
+}
+
 // Pinhole intrinsics and distortion of one camera.
 struct CameraIntrinsics {
   int width = 0, height = 0;          // [px]
