@@ -10,7 +10,7 @@ PACKAGES=(
   libtbb-dev libnanoflann-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libbz2-dev liblz4-dev
-  python3-matplotlib python3-numpy python3-rosbag python3-roslz4
+  python3-matplotlib python3-numpy python3-rosbag python3-roslz4 python3-onnx
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

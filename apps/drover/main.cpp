@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
   drover::cli::registerInfo(app);
   drover::cli::registerSim(app);
   drover::cli::registerRun(app);
+  drover::cli::registerLoop(app);
+  drover::cli::registerGraph(app);
+  drover::cli::registerFeatures(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -197,12 +197,12 @@ DatasetOptions loadDatasetOptions(const std::string& yaml_path) {
   if (root.IsNull()) return {};  // an empty file: all defaults
   if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
   // Every module's section is known here, so a misspelt one ("odometri:") cannot be silently ignored.
-  static const std::vector<std::string> known = {"dataset", "calibration", "sim", "odometry"};
+  static const std::vector<std::string> known = {"dataset", "calibration", "sim", "odometry", "loop", "visual"};
   for (const auto& kv : root) {
     const std::string name = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), name) == known.end())
       fail(yaml_path, lineRecord(static_cast<std::size_t>(kv.first.Mark().line + 1)) + ", section '" + name + "'",
-           "unknown section (expected dataset, calibration, sim or odometry)");
+           "unknown section (expected dataset, calibration, sim, odometry, loop or visual)");
   }
   DatasetOptions options;
   readDataset(SectionReader(section(root, "dataset", yaml_path), "dataset", yaml_path), options);
