@@ -15,5 +15,6 @@ void registerFeatures(CLI::App& app);  // cmd_features.cpp: drover features dete
 // The two halves of `drover features`, each in its own file.
 void registerFeaturesDetect(CLI::App& features);  // cmd_features_detect.cpp
 void registerFeaturesTrack(CLI::App& features);   // cmd_features_track.cpp
+void registerLoopEval(CLI::App& loop);            // cmd_loop_eval.cpp
 
 }  // namespace drover::cli

@@ -185,6 +185,16 @@ AugmentedMatch augmentedShiftSearch(const ScanContext& a, const AugmentedScanCon
   return best;
 }
 
+Eigen::Isometry3d relativePoseFromMatch(const AugmentedMatch& match, const Eigen::Matrix3d& R_tilt) {
+  const double yaw = match.match.yaw;
+  const double tilt_yaw = std::atan2(R_tilt(1, 0), R_tilt(0, 0));
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::AngleAxisd(yaw - tilt_yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_tilt;
+  const Eigen::Vector3d offset(match.offset.x(), match.offset.y(), 0.0);
+  T.translation() = -(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * offset);
+  return T;
+}
+
 double yawFromShift(int shift, int sectors) {
   double yaw = wrapShift(shift, sectors) * kTwoPi / sectors;
   if (yaw > std::numbers::pi) yaw -= kTwoPi;

@@ -16,6 +16,7 @@
 // also made from virtual sensor positions on a small x-y grid around the real one, and the best match over them is
 // kept. On the KITTI 08 revisit (3.1 m apart, 148 deg) this takes the distance from 0.22 to 0.12.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,6 +92,13 @@ struct AugmentedMatch {
 // Full (no prior) or prior-narrowed search (narrowedShiftSearch) of descriptor A against every descriptor of B.
 AugmentedMatch augmentedShiftSearch(const ScanContext& a, const AugmentedScanContext& b,
                                     std::optional<double> yaw_prior, const ScanContextConfig& config);
+
+// The relative pose of the query (B) in the candidate's (A) lidar frame that a match implies: yaw about z from
+// the shift, applied to R_candidate_query_tilt's roll and pitch (e.g. the estimate's relative rotation; identity
+// when there is none), and the translation that puts B's sensor where the chosen virtual position says A's sensor
+// is seen from B (t = -Rz(yaw) [offset; 0]; z = 0: same ground height).
+Eigen::Isometry3d relativePoseFromMatch(const AugmentedMatch& match,
+                                        const Eigen::Matrix3d& R_candidate_query_tilt = Eigen::Matrix3d::Identity());
 
 double yawFromShift(int shift, int sectors);   // [rad] in (-pi, pi]
 int shiftFromYaw(double yaw, int sectors);      // nearest shift in [0, sectors)

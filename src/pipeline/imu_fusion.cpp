@@ -90,6 +90,14 @@ void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias) {
   propagator_.reset(state, bias);
 }
 
+void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
+  if (!initialized_ || !smoother_.initialized()) return;
+  imu::NavState state = smoother_.state();
+  state.T_world_imu = T_new_old * state.T_world_imu;
+  state.v_world = T_new_old.linear() * state.v_world;
+  restart(state, smoother_.bias());
+}
+
 std::optional<lidar::SweepMotion> ImuFusion::sweepMotion(Time t0, Time t_end) const {
   if (!initialized_) return std::nullopt;
   return imuMotion(propagator_, T_imu_lidar_, t0, t_end);

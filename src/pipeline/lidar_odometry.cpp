@@ -35,6 +35,15 @@ struct LidarOdometry::Impl {
   Trajectory trajectory;          // T_world_lidar per processed sweep
   Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
   OdometryStats stats;
+  LoopClosure loops;
+  // Per trajectory entry: the keyframe it followed and its pose relative to it, so a loop correction of the
+  // keyframes carries every sweep with it.
+  struct Anchor {
+    std::size_t keyframe = 0;
+    Eigen::Isometry3d T_kf_sweep = Eigen::Isometry3d::Identity();
+  };
+  std::vector<Anchor> anchors;
+  geometry::Matrix6d degenerate_since_kf = geometry::Matrix6d::Zero();  // sum of d d^T since the last keyframe
   int degenerate_run = 0;               // consecutive degenerate sweeps
   std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
 
@@ -46,7 +55,8 @@ struct LidarOdometry::Impl {
         map(c.local_map),
         matcher(c.matcher),
         policy(c.keyframes),
-        fusion(c, calib.T_imu_lidar) {}
+        fusion(c, calib.T_imu_lidar),
+        loops(c.loop) {}
 
   std::vector<ScanOutcome> onScan(LidarScan scan);
   std::vector<ScanOutcome> drain(bool force);
@@ -61,6 +71,9 @@ struct LidarOdometry::Impl {
     if (stats.notices.size() < OdometryStats::kMaxNotices) stats.notices.push_back(std::move(line));
   }
   void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
+  void accumulateDegeneracy(const ScanOutcome& out);
+  void applyLoopCorrection(ScanOutcome& out);
+  void record(const ScanOutcome& out);
 };
 
 LidarOdometry::LidarOdometry(const OdometryConfig& config, const Calibration& calibration) {
@@ -102,6 +115,8 @@ const OdometryStats& LidarOdometry::stats() const {
 }
 
 const OdometryConfig& LidarOdometry::config() const { return impl_->config; }
+
+const LoopClosure& LidarOdometry::loopClosure() const { return impl_->loops; }
 
 // Sweeps are stamped at their start; t_imu = t_lidar + offset puts them on the IMU's clock.
 std::vector<ScanOutcome> LidarOdometry::Impl::onScan(LidarScan scan) {
@@ -178,8 +193,9 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   }
   if (out.imu_used) ++stats.imu_scans;
 
+  accumulateDegeneracy(out);
   keyframe(features, out);
-  trajectory.push_back({scan.t, out.T_world_lidar});
+  record(out);
   ++stats.scans_processed;
   stats.imu_initialized = fusion.initialized();
   stats.imu_init = fusion.initNote();
@@ -293,10 +309,50 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
   }
   if (!first && !restart && !policy.isKeyframe(T_world_lastkf, out.T_world_lidar)) return;
 
-  map.addKeyframe(features, out.T_world_lidar);
+  const std::size_t index = map.addKeyframe(features, out.T_world_lidar);
   T_world_lastkf = out.T_world_lidar;
   out.keyframe = true;
   ++stats.keyframes;
+  const bool closed = loops.addKeyframe(map, index, degenerate_since_kf);
+  degenerate_since_kf.setZero();
+  if (closed) applyLoopCorrection(out);
+}
+
+// What the pose graph is told about the sweeps between keyframes: each degenerate direction (and every direction
+// of a failed match) loosens the odometry edge along it.
+void LidarOdometry::Impl::accumulateDegeneracy(const ScanOutcome& out) {
+  if (!out.match_usable) {
+    degenerate_since_kf += geometry::Matrix6d::Identity();
+    return;
+  }
+  for (const geometry::Vector6d& d : out.degenerate_directions)
+    degenerate_since_kf += d.normalized() * d.normalized().transpose();
+}
+
+// The graph moved the keyframes: the map, every sweep (through its keyframe), the current sweep and the IMU
+// smoother follow. T_new_old maps the newest keyframe's old pose onto its corrected one.
+void LidarOdometry::Impl::applyLoopCorrection(ScanOutcome& out) {
+  const std::vector<Eigen::Isometry3d> poses = loops.poses();
+  const std::size_t last = poses.size() - 1;
+  const Eigen::Isometry3d T_new_old = poses[last] * map.keyframe(last).T_world_lidar.inverse();
+  for (std::size_t i = 0; i < poses.size(); ++i) map.updatePose(i, poses[i]);
+  for (std::size_t i = 0; i < trajectory.size(); ++i)
+    trajectory[i].T_world_body = poses[anchors[i].keyframe] * anchors[i].T_kf_sweep;
+  out.T_world_lidar = poses[last];
+  T_world_lastkf = poses[last];
+  fusion.reanchor(T_new_old);
+  out.loop_closed = true;
+  stats.loop_times.push_back(out.t);
+  const LoopEvent& e = loops.events().back();
+  out.warning += std::string(out.warning.empty() ? "" : "; ") +
+                 fmt::format("loop closed with keyframe {} ({:.1f} s earlier): trajectory corrected by {:.2f} m",
+                             e.candidate, toSeconds(e.t_query - e.t_candidate), e.correction);
+}
+
+void LidarOdometry::Impl::record(const ScanOutcome& out) {
+  const std::size_t kf = map.size() - 1;
+  anchors.push_back({kf, map.keyframe(kf).T_world_lidar.inverse() * out.T_world_lidar});
+  trajectory.push_back({out.t, out.T_world_lidar});
 }
 
 }  // namespace drover::pipeline

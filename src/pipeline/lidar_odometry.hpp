@@ -17,6 +17,7 @@
 #include "imu/preintegration.hpp"
 #include "imu/propagator.hpp"
 #include "lidar/feature_set.hpp"
+#include "pipeline/loop_closure.hpp"
 #include "pipeline/odometry_config.hpp"
 #include "types/calibration.hpp"
 #include "types/measurement.hpp"
@@ -47,6 +48,7 @@ struct ScanOutcome {
   int edge_inliers = 0, plane_inliers = 0;
   std::size_t points = 0, edges = 0, planes = 0;  // valid points in, features out
   bool reset = false;             // the smoother diverged and was reset at this sweep
+  bool loop_closed = false;       // this sweep's keyframe closed a loop: the trajectory so far was corrected
   std::string warning;            // one line when something was off with this sweep
   StageTimes ms;
 };
@@ -68,6 +70,7 @@ struct OdometryStats {
   std::vector<Time> degenerate_times;    // [ns] sweep times of degenerate matches
   std::vector<Time> reset_times;         // [ns] sweep times of smoother resets
   std::vector<Time> map_restart_times;   // [ns] sweeps where a long degenerate stretch restarted the local map
+  std::vector<Time> loop_times;          // [ns] sweeps whose keyframe closed a loop (see loopClosure().events())
   // One line per skipped sweep (the first kMaxNotices; the counters above count them all), for the caller to show.
   static constexpr std::size_t kMaxNotices = 200;
   std::vector<std::string> notices;
@@ -87,12 +90,15 @@ class LidarOdometry {
   // Processes the sweeps still waiting for IMU data (end of the stream).
   std::vector<ScanOutcome> finish();
 
-  const Trajectory& trajectory() const;     // T_world_lidar at every processed sweep's start
+  // T_world_lidar at every processed sweep's start; after a loop closure every pose is re-expressed relative to
+  // its keyframe's corrected pose (the pose relative to the keyframe the sweep followed is kept).
+  const Trajectory& trajectory() const;
   Trajectory keyframeTrajectory() const;    // T_world_lidar of the keyframes
   // The keyframes' full clouds in the world frame, voxel-downsampled with leaf [m].
   lidar::PointCloud mapCloud(float leaf) const;
   const OdometryStats& stats() const;
   const OdometryConfig& config() const;
+  const LoopClosure& loopClosure() const;  // loop events and statistics
 
  private:
   struct Impl;

@@ -27,7 +27,7 @@ std::string OdometryConfig::validate() const {
       {"local_map", local_map.validate()},    {"matcher", matcher.validate()},
       {"keyframes", keyframes.validate()},    {"preintegration", preintegration.validate()},
       {"propagator", propagator.validate()},  {"initializer", initializer.validate()},
-      {"smoother", smoother.validate()}};
+      {"smoother", smoother.validate()},      {"loop", loop.validate()}};
   for (const auto& [name, error] : parts)
     if (!error.empty()) return prefixed(name, error);
   return {};

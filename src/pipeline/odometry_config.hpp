@@ -13,6 +13,7 @@
 #include "lidar/local_map.hpp"
 #include "lidar/scan_layout.hpp"
 #include "lidar/scan_matcher.hpp"
+#include "pipeline/loop_closure.hpp"
 
 namespace drover::pipeline {
 
@@ -51,6 +52,7 @@ struct OdometryConfig {
   imu::ImuPropagator::Config propagator;
   imu::StaticInitializer::Config initializer;
   backend::FixedLagSmootherConfig smoother;
+  LoopClosureConfig loop;  // the `loop:` section of platform configs (on by default)
   // Empty when valid, else the first problem found, naming the component and value.
   std::string validate() const;
 };

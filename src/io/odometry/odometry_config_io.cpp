@@ -6,6 +6,7 @@
 
 #include "io/config.hpp"
 #include "io/error.hpp"
+#include "io/odometry/loop_config_io.hpp"
 #include "io/text_parsing.hpp"
 #include "io/yaml_section.hpp"
 
@@ -150,6 +151,15 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .nested("smoother", [&](YamlSection& s) { bindSmoother(s, c.smoother); });
   top.apply(root["odometry"]);
   applyEnums(e, c);
+  // The loop closure has its own top-level section; the matcher and submap of its verifier follow the odometry's.
+  c.loop.verifier.matcher = c.matcher;
+  c.loop.verifier.submap.edge_leaf = c.local_map.edge_leaf;
+  c.loop.verifier.submap.plane_leaf = c.local_map.plane_leaf;
+  LoopEnumStrings le;
+  YamlSection loop(yaml_path, "loop");
+  bindLoopSection(loop, c.loop, le);
+  loop.apply(root["loop"]);
+  applyLoopEnums(le, c.loop);
   c.features.edge_threshold = static_cast<float>(f.edge_threshold);
   c.features.surf_threshold = static_cast<float>(f.surf_threshold);
   c.features.occlusion_depth_gap = static_cast<float>(f.occlusion_depth_gap);

@@ -13,6 +13,7 @@
 //     keyframes:    distance [m], angle [rad]
 //     imu:          gyro_noise_density, acc_noise_density, gyro_bias_random_walk, acc_bias_random_walk, gravity
 //     smoother:     window, max_iterations, ...
+//   loop: (its own top-level section) see io/odometry/loop_config_io.hpp
 // Lives in its own library (drover_io_odometry) so that the readers do not depend on the odometry modules.
 #include <string>
 

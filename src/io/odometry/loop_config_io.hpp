@@ -1,0 +1,27 @@
+#pragma once
+// The `loop:` section of a platform config -> pipeline::LoopClosureConfig (read by loadOdometryConfig). Keys, all
+// optional (left out = the defaults in pipeline/loop_closure.hpp and loop/*.hpp, which give the units):
+//   loop: enabled, source (scancontext | radius | both), yaw_prior, min_age [s], submap_keyframes,
+//         max_verifications, skip_after_loop, radius [m], odometry_sigma_position [m], odometry_sigma_rotation [rad],
+//         degenerate_sigma
+//     scan_context: rings, sectors, max_radius [m], sensor_height [m], threshold, search_radius [sectors],
+//                   lateral_step [m], lateral_steps, candidates, exclude_recent [keyframes]
+//     verifier:     max_fitness [m], min_inliers, min_inlier_ratio, max_correction_translation [m],
+//                   max_correction_rotation [rad], sigma_floor_position [m], sigma_floor_rotation [rad]
+//     graph:        max_iterations, loop_loss (none | huber | cauchy), loop_loss_scale
+#include <string>
+
+#include "io/yaml_section.hpp"
+#include "pipeline/loop_closure.hpp"
+
+namespace drover::io {
+
+// Enumerations travel as strings and are applied by applyLoopEnums after YamlSection::apply.
+struct LoopEnumStrings {
+  std::string source = "scancontext", loop_loss = "huber";
+};
+
+void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStrings& e);
+void applyLoopEnums(const LoopEnumStrings& e, pipeline::LoopClosureConfig& c);
+
+}  // namespace drover::io

@@ -1,0 +1,244 @@
+#include "pipeline/loop_closure.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+
+namespace drover::pipeline {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
+
+// A candidate before verification: where it came from and the guess of the query in its frame.
+struct Candidate {
+  std::size_t index = 0;
+  std::string source;
+  Eigen::Isometry3d T_candidate_query_guess = Eigen::Isometry3d::Identity();
+  std::optional<loop::LoopCandidate> sc;
+};
+
+}  // namespace
+
+const char* toString(LoopSource source) {
+  switch (source) {
+    case LoopSource::kRadius:
+      return "radius";
+    case LoopSource::kBoth:
+      return "both";
+    case LoopSource::kScanContext:
+      break;
+  }
+  return "scancontext";
+}
+
+std::string LoopClosureConfig::validate() const {
+  if (std::string e = database.validate(); !e.empty()) return "database: " + e;
+  if (std::string e = verifier.validate(); !e.empty()) return "verifier: " + e;
+  if (std::string e = graph.validate(); !e.empty()) return "graph: " + e;
+  const double positive[] = {radius, odometry_sigma_position, odometry_sigma_rotation, degenerate_sigma};
+  for (double v : positive)
+    if (!std::isfinite(v) || v <= 0) return "radius, odometry_sigma_* and degenerate_sigma must be finite and > 0";
+  if (!std::isfinite(min_age) || min_age < 0) return "min_age must be finite and >= 0 s";
+  if (submap_keyframes < 0 || max_verifications < 1 || skip_after_loop < 0)
+    return "submap_keyframes and skip_after_loop must be >= 0, max_verifications >= 1";
+  return {};
+}
+
+struct LoopClosure::Impl {
+  LoopClosureConfig config;
+  loop::ScanContextDatabase database;
+  loop::LoopVerifier verifier;
+  backend::PoseGraph graph;
+  std::vector<Time> times;
+  std::vector<LoopEvent> events;
+  LoopStats stats;
+  int skip = 0;
+
+  explicit Impl(const LoopClosureConfig& c)
+      : config(c), database(c.database), verifier(c.verifier), graph(c.graph) {}
+
+  void addOdometryEdge(const lidar::LocalMap& map, std::size_t index, const geometry::Matrix6d& degenerate_cov);
+  std::vector<Candidate> candidates(const lidar::LocalMap& map, std::size_t index,
+                                    const loop::AugmentedScanContext& query);
+  std::optional<Candidate> radiusCandidate(const lidar::LocalMap& map, std::size_t index) const;
+  bool tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c);
+};
+
+LoopClosure::LoopClosure(const LoopClosureConfig& config) {
+  if (std::string e = config.validate(); !e.empty()) throw std::invalid_argument("loop closure config: " + e);
+  impl_ = std::make_unique<Impl>(config);
+}
+
+LoopClosure::~LoopClosure() = default;
+
+// Sigma per keyframe step, plus degenerate_sigma^2 d d^T per degenerate sweep; the directions are in the sweeps'
+// lidar frames, taken as the current keyframe's and rotated into the previous one's (the edge's `from` frame).
+void LoopClosure::Impl::addOdometryEdge(const lidar::LocalMap& map, std::size_t index,
+                                        const geometry::Matrix6d& degenerate_cov) {
+  const Eigen::Isometry3d T_prev_cur =
+      map.keyframe(index - 1).T_world_lidar.inverse() * map.keyframe(index).T_world_lidar;
+  geometry::Matrix6d J = geometry::Matrix6d::Identity();
+  J.topLeftCorner<3, 3>() = T_prev_cur.linear();
+  geometry::Matrix6d cov = config.degenerate_sigma * config.degenerate_sigma * J * degenerate_cov * J.transpose();
+  cov.diagonal().head<3>().array() += config.odometry_sigma_position * config.odometry_sigma_position;
+  cov.diagonal().tail<3>().array() += config.odometry_sigma_rotation * config.odometry_sigma_rotation;
+  geometry::Matrix6d information = cov.inverse();
+  information = 0.5 * (information + information.transpose());
+  graph.addEdge(static_cast<int>(index - 1), static_cast<int>(index), T_prev_cur, information,
+                backend::EdgeKind::kOdometry);
+}
+
+bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, const geometry::Matrix6d& degenerate_cov) {
+  Impl& m = *impl_;
+  if (index != m.times.size())
+    throw std::invalid_argument(fmt::format("loop closure: keyframe {} given, {} expected", index, m.times.size()));
+  const lidar::Keyframe& kf = map.keyframe(index);
+  m.times.push_back(kf.t);
+  m.graph.addNode(static_cast<int>(index), kf.T_world_lidar);
+  if (index > 0) m.addOdometryEdge(map, index, degenerate_cov);
+  if (!m.config.enabled) return false;
+
+  auto t0 = Clock::now();
+  const loop::AugmentedScanContext query = loop::makeAugmentedScanContext(kf.features.full, m.config.database.descriptor);
+  m.stats.descriptor_ms += msSince(t0);
+  bool closed = false;
+  if (m.skip > 0) {
+    --m.skip;
+  } else {
+    ++m.stats.queries;
+    for (const Candidate& c : m.candidates(map, index, query)) {
+      if (m.tryCandidate(map, index, c)) {
+        closed = true;
+        m.skip = m.config.skip_after_loop;
+        break;
+      }
+    }
+  }
+  m.database.add(static_cast<int>(index), query.descriptors[0]);
+  return closed;
+}
+
+// Scan Context candidates under the threshold (best first), then the radius candidate, each old enough; at most
+// max_verifications, no candidate twice.
+std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map, std::size_t index,
+                                                     const loop::AugmentedScanContext& query) {
+  std::vector<Candidate> out;
+  const Time newest = times[index] - fromSeconds(config.min_age);
+  const Eigen::Isometry3d& T_world_query = map.keyframe(index).T_world_lidar;
+  if (config.source != LoopSource::kRadius) {
+    auto t0 = Clock::now();
+    auto prior = [&](int id) -> std::optional<double> {
+      if (!config.yaw_prior) return std::nullopt;
+      return yawOf(map.keyframe(static_cast<std::size_t>(id)).T_world_lidar.linear().transpose() *
+                   T_world_query.linear());
+    };
+    const loop::DatabaseQuery q = database.query(query, prior);
+    stats.query_ms += msSince(t0);
+    for (const loop::LoopCandidate& lc : q.candidates) {
+      if (lc.match.match.narrowed) ++stats.narrowed_searches;
+      if (lc.match.match.fell_back) ++stats.fallbacks;
+      const std::size_t id = static_cast<std::size_t>(lc.id);
+      if (lc.match.match.distance >= config.database.descriptor.threshold || times[id] > newest) continue;
+      // Guess: the Scan Context yaw and lateral offset, with the estimate's relative tilt.
+      const Eigen::Matrix3d R_est = map.keyframe(id).T_world_lidar.linear().transpose() * T_world_query.linear();
+      Candidate c{id, "scancontext", loop::relativePoseFromMatch(lc.match, R_est), lc};
+      out.push_back(c);
+    }
+  }
+  if (config.source != LoopSource::kScanContext)
+    if (std::optional<Candidate> r = radiusCandidate(map, index)) out.push_back(*r);
+  std::vector<Candidate> unique;
+  for (const Candidate& c : out) {
+    const bool seen = std::any_of(unique.begin(), unique.end(), [&](const Candidate& u) { return u.index == c.index; });
+    if (!seen && static_cast<int>(unique.size()) < config.max_verifications) unique.push_back(c);
+  }
+  stats.candidates += unique.size();
+  return unique;
+}
+
+// The nearest keyframe (in the current estimate) within `radius` that is at least min_age older than the query.
+std::optional<Candidate> LoopClosure::Impl::radiusCandidate(const lidar::LocalMap& map, std::size_t index) const {
+  const Time newest = times[index] - fromSeconds(config.min_age);
+  const Eigen::Isometry3d& T_world_query = map.keyframe(index).T_world_lidar;
+  std::optional<Candidate> best;
+  double best_d = config.radius;
+  for (std::size_t i = 0; i < index && times[i] <= newest; ++i) {
+    const double d = (map.keyframe(i).T_world_lidar.translation() - T_world_query.translation()).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = Candidate{i, "radius", map.keyframe(i).T_world_lidar.inverse() * T_world_query, std::nullopt};
+    }
+  }
+  return best;
+}
+
+// Verifies one candidate against its submap; when accepted adds the loop edge and re-solves the graph.
+bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c) {
+  const Time newest = times[index] - fromSeconds(config.min_age);
+  const std::size_t n = static_cast<std::size_t>(config.submap_keyframes);
+  const std::size_t first = c.index > n ? c.index - n : 0;
+  std::vector<loop::SubmapKeyframe> submap;
+  std::size_t candidate_in_submap = 0;
+  for (std::size_t i = first; i <= c.index + n && i < index && times[i] <= newest; ++i) {
+    if (i == c.index) candidate_in_submap = submap.size();
+    submap.push_back({&map.keyframe(i).features, map.keyframe(i).T_world_lidar});
+  }
+  LoopEvent e;
+  e.query = index;
+  e.candidate = c.index;
+  e.t_query = times[index];
+  e.t_candidate = times[c.index];
+  e.source = c.source;
+  if (c.sc) {
+    e.sc_distance = c.sc->match.match.distance;
+    e.shift = c.sc->match.match.shift;
+    e.sc_yaw = c.sc->match.match.yaw;
+    e.narrowed = c.sc->match.match.narrowed;
+    e.fell_back = c.sc->match.match.fell_back;
+  }
+  auto t0 = Clock::now();
+  e.verification = verifier.verify(map.keyframe(index).features, submap, candidate_in_submap, c.T_candidate_query_guess);
+  stats.verify_ms += msSince(t0);
+  ++stats.verified;
+  if (e.verification.accepted) {
+    const Eigen::Vector3d before = graph.pose(static_cast<int>(index)).translation();
+    const std::size_t edge = graph.addEdge(static_cast<int>(c.index), static_cast<int>(index),
+                                           e.verification.T_candidate_query, e.verification.information,
+                                           backend::EdgeKind::kLoop);
+    const backend::PoseGraphResult r = graph.optimize();
+    e.graph_initial_cost = r.initial_cost;
+    e.graph_final_cost = r.final_cost;
+    e.graph_ms = r.time_ms;
+    stats.graph_ms += r.time_ms;
+    if (!r.usable) {
+      graph.setEdgeEnabled(edge, false);
+      e.verification.accepted = false;
+      e.verification.reason = "rejected: pose graph failed (" + r.reason + ")";
+    } else {
+      e.correction = (graph.pose(static_cast<int>(index)).translation() - before).norm();
+      ++stats.accepted;
+    }
+  }
+  events.push_back(e);
+  return e.verification.accepted;
+}
+
+std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
+  std::vector<Eigen::Isometry3d> out;
+  out.reserve(impl_->times.size());
+  for (std::size_t i = 0; i < impl_->times.size(); ++i) out.push_back(impl_->graph.pose(static_cast<int>(i)));
+  return out;
+}
+
+const std::vector<LoopEvent>& LoopClosure::events() const { return impl_->events; }
+const LoopStats& LoopClosure::stats() const { return impl_->stats; }
+const LoopClosureConfig& LoopClosure::config() const { return impl_->config; }
+
+}  // namespace drover::pipeline

@@ -1,0 +1,92 @@
+#pragma once
+// Loop closure of the LIS (LIO-SAM's loopClosureThread + the keyframe graph of mapOptimization, without globals):
+// every keyframe becomes a pose-graph node linked to the previous one by its odometry; its Scan Context goes into
+// the database; candidates come from Scan Context (ring-key retrieval, prior-narrowed shift search) and/or from a
+// radius search around the current estimate (LIO-SAM's detectLoopClosureDistance); each is verified by scan
+// matching against the candidate's submap (loop/loop_verifier.hpp) and, when accepted, becomes a loop edge and the
+// graph is re-solved from the current poses. The caller (LidarOdometry) then moves its keyframe map, trajectory and
+// IMU smoother onto the corrected poses, as LIO-SAM's correctPoses does after an iSAM2 update.
+//
+// Odometry edges get sigmas per keyframe step plus, along each direction the scan matcher reported degenerate in
+// the sweeps since the previous keyframe, degenerate_sigma per such sweep: a loop then bends the trajectory where
+// the lidar could not see (a featureless corridor) rather than everywhere. Deterministic, single-threaded.
+#include <Eigen/Geometry>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "backend/pose_graph.hpp"
+#include "geometry/se3.hpp"
+#include "lidar/local_map.hpp"
+#include "loop/loop_verifier.hpp"
+#include "loop/scan_context_database.hpp"
+
+namespace drover::pipeline {
+
+enum class LoopSource { kScanContext, kRadius, kBoth };
+const char* toString(LoopSource source);  // "scancontext", "radius", "both"
+
+struct LoopClosureConfig {
+  bool enabled = true;
+  LoopSource source = LoopSource::kScanContext;
+  loop::ScanContextDatabaseConfig database;  // descriptor (rings, sectors, radius, sensor height, threshold, dh)
+  loop::LoopVerifierConfig verifier;
+  bool yaw_prior = true;          // narrow the shift search around the estimate's relative yaw (Eqs. 2-4)
+  double min_age = 30.0;          // [s] candidates at least this much older than the query (LIO-SAM 30 s)
+  int submap_keyframes = 10;      // [keyframes] on each side of the candidate in its verification submap
+  int max_verifications = 2;      // [-] candidates verified per keyframe at most (best Scan Context first)
+  int skip_after_loop = 2;        // [keyframes] no detection for this many keyframes after an accepted loop
+  double radius = 10.0;           // [m] radius source: nearest old keyframe within this distance (LIO-SAM 15 m)
+  double odometry_sigma_position = 0.02;   // [m] per keyframe step
+  double odometry_sigma_rotation = 0.002;  // [rad] per keyframe step
+  double degenerate_sigma = 0.5;  // [m or rad] per degenerate sweep, along its degenerate directions
+  backend::PoseGraphConfig graph;
+  std::string validate() const;  // empty when valid
+};
+
+// One verified candidate, accepted or not.
+struct LoopEvent {
+  std::size_t query = 0, candidate = 0;  // keyframe indices
+  Time t_query = 0, t_candidate = 0;     // [ns]
+  std::string source;                    // "scancontext" or "radius"
+  double sc_distance = -1;               // [-] Scan Context distance (-1 for radius candidates)
+  int shift = 0;                         // [sectors]
+  double sc_yaw = 0;                     // [rad] yaw of the query in the candidate frame from the shift
+  bool narrowed = false, fell_back = false;
+  loop::LoopVerification verification;
+  double graph_initial_cost = 0, graph_final_cost = 0, graph_ms = 0;  // of the re-solve (accepted only)
+  double correction = 0;  // [m] how far the re-solve moved the query keyframe
+};
+
+struct LoopStats {
+  std::size_t queries = 0;           // keyframes searched
+  std::size_t candidates = 0;        // Scan Context candidates under the threshold, plus radius candidates
+  std::size_t verified = 0, accepted = 0;
+  std::size_t narrowed_searches = 0, fallbacks = 0;  // prior-narrowed shift searches, and their fall-backs
+  double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
+};
+
+class LoopClosure {
+ public:
+  // Throws std::invalid_argument when config.validate() fails.
+  explicit LoopClosure(const LoopClosureConfig& config);
+  ~LoopClosure();
+  LoopClosure(const LoopClosure&) = delete;
+  LoopClosure& operator=(const LoopClosure&) = delete;
+
+  // Called once per keyframe right after map.addKeyframe (index = its map index, in order). degenerate_cov is
+  // the sum over the sweeps since the previous keyframe of d d^T for each unit degenerate direction d ([rho; phi],
+  // lidar frame). Returns true when a loop was accepted and the graph re-solved: then poses() differ from the map's.
+  bool addKeyframe(const lidar::LocalMap& map, std::size_t index, const geometry::Matrix6d& degenerate_cov);
+
+  std::vector<Eigen::Isometry3d> poses() const;  // T_world_lidar of every keyframe from the graph, by index
+  const std::vector<LoopEvent>& events() const;
+  const LoopStats& stats() const;
+  const LoopClosureConfig& config() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace drover::pipeline
