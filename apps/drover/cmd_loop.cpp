@@ -36,7 +36,6 @@ pipeline::OdometryConfig pairConfig(const PairOptions& o) {
   c.features.columns = c.layout.columns;
   c.features.min_range = static_cast<float>(c.layout.min_range);
   c.features.max_range = static_cast<float>(c.layout.max_range);
-  c.loop.database.descriptor.sensor_height = 1.73;  // [m] KITTI's Velodyne above the road
   return c;
 }
 

@@ -74,6 +74,7 @@ void checkOptions(const RunOptions& o) {
 void keep(std::vector<pipeline::ScanOutcome>&& outcomes, RunRecord& record) {
   for (pipeline::ScanOutcome& s : outcomes) {
     if (!s.warning.empty()) spdlog::warn("sweep at {:.3f} s: {}", toSeconds(s.t), s.warning);
+    if (!s.note.empty()) spdlog::info("sweep at {:.3f} s: {}", toSeconds(s.t), s.note);
     record.scans.push_back(std::move(s));
   }
 }

@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "apps/drover/eval_report.hpp"
+#include "apps/drover/loop_report.hpp"
 #include "eval/ape.hpp"
 #include "io/cloud_io.hpp"
 #include "io/kitti_common.hpp"
@@ -61,6 +62,7 @@ Json timingsJson(const RunRecord& r) {
       {"preprocess", &pipeline::StageTimes::preprocess}, {"deskew", &pipeline::StageTimes::deskew},
       {"features", &pipeline::StageTimes::features},     {"map", &pipeline::StageTimes::map},
       {"match", &pipeline::StageTimes::match},           {"smoother", &pipeline::StageTimes::smoother},
+      {"loop", &pipeline::StageTimes::loop},
       {"total", &pipeline::StageTimes::total}};
   for (const auto& [name, member] : stages) {
     std::vector<double> v;
@@ -177,6 +179,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["counts"] = statsJson(s);
   report["timings"] = timingsJson(r);
   report["ape"] = evaluate(c, est);
+  report["loops"] = loopsJson(c, odometry);
   report["scans"] = scansJson(r);
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",

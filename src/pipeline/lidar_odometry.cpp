@@ -313,9 +313,11 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
   T_world_lastkf = out.T_world_lidar;
   out.keyframe = true;
   ++stats.keyframes;
+  const auto t0 = Clock::now();
   const bool closed = loops.addKeyframe(map, index, degenerate_since_kf);
   degenerate_since_kf.setZero();
   if (closed) applyLoopCorrection(out);
+  out.ms.loop = msSince(t0);
 }
 
 // What the pose graph is told about the sweeps between keyframes: each degenerate direction (and every direction
@@ -344,8 +346,7 @@ void LidarOdometry::Impl::applyLoopCorrection(ScanOutcome& out) {
   out.loop_closed = true;
   stats.loop_times.push_back(out.t);
   const LoopEvent& e = loops.events().back();
-  out.warning += std::string(out.warning.empty() ? "" : "; ") +
-                 fmt::format("loop closed with keyframe {} ({:.1f} s earlier): trajectory corrected by {:.2f} m",
+  out.note = fmt::format("loop closed with keyframe {} ({:.1f} s earlier): trajectory corrected by {:.2f} m",
                              e.candidate, toSeconds(e.t_query - e.t_candidate), e.correction);
 }
 

@@ -27,7 +27,7 @@ namespace drover::pipeline {
 
 // Wall time of each stage for one sweep [ms].
 struct StageTimes {
-  double preprocess = 0, deskew = 0, features = 0, map = 0, match = 0, smoother = 0, total = 0;
+  double preprocess = 0, deskew = 0, features = 0, map = 0, match = 0, smoother = 0, loop = 0, total = 0;
 };
 
 // What happened to one sweep.
@@ -50,6 +50,7 @@ struct ScanOutcome {
   bool reset = false;             // the smoother diverged and was reset at this sweep
   bool loop_closed = false;       // this sweep's keyframe closed a loop: the trajectory so far was corrected
   std::string warning;            // one line when something was off with this sweep
+  std::string note;               // one line of news (a loop closed), not a problem
   StageTimes ms;
 };
 

@@ -57,6 +57,7 @@ struct LoopClosure::Impl {
   loop::LoopVerifier verifier;
   backend::PoseGraph graph;
   std::vector<Time> times;
+  std::vector<bool> searched;  // by keyframe
   std::vector<LoopEvent> events;
   LoopStats stats;
   int skip = 0;
@@ -68,7 +69,8 @@ struct LoopClosure::Impl {
   std::vector<Candidate> candidates(const lidar::LocalMap& map, std::size_t index,
                                     const loop::AugmentedScanContext& query);
   std::optional<Candidate> radiusCandidate(const lidar::LocalMap& map, std::size_t index) const;
-  bool tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c);
+  bool tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c,
+                    const loop::AugmentedScanContext& query);
 };
 
 LoopClosure::LoopClosure(const LoopClosureConfig& config) {
@@ -101,6 +103,7 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
     throw std::invalid_argument(fmt::format("loop closure: keyframe {} given, {} expected", index, m.times.size()));
   const lidar::Keyframe& kf = map.keyframe(index);
   m.times.push_back(kf.t);
+  m.searched.push_back(false);
   m.graph.addNode(static_cast<int>(index), kf.T_world_lidar);
   if (index > 0) m.addOdometryEdge(map, index, degenerate_cov);
   if (!m.config.enabled) return false;
@@ -113,8 +116,9 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
     --m.skip;
   } else {
     ++m.stats.queries;
+    m.searched[index] = true;
     for (const Candidate& c : m.candidates(map, index, query)) {
-      if (m.tryCandidate(map, index, c)) {
+      if (m.tryCandidate(map, index, c, query)) {
         closed = true;
         m.skip = m.config.skip_after_loop;
         break;
@@ -180,7 +184,8 @@ std::optional<Candidate> LoopClosure::Impl::radiusCandidate(const lidar::LocalMa
 }
 
 // Verifies one candidate against its submap; when accepted adds the loop edge and re-solves the graph.
-bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c) {
+bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c,
+                                     const loop::AugmentedScanContext& query) {
   const Time newest = times[index] - fromSeconds(config.min_age);
   const std::size_t n = static_cast<std::size_t>(config.submap_keyframes);
   const std::size_t first = c.index > n ? c.index - n : 0;
@@ -202,6 +207,9 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
     e.sc_yaw = c.sc->match.match.yaw;
     e.narrowed = c.sc->match.match.narrowed;
     e.fell_back = c.sc->match.match.fell_back;
+    e.full_shift = loop::fullShiftSearch(database.descriptor(static_cast<int>(c.index)),
+                                         query.descriptors[static_cast<std::size_t>(c.sc->match.index)])
+                       .shift;
   }
   auto t0 = Clock::now();
   e.verification = verifier.verify(map.keyframe(index).features, submap, candidate_in_submap, c.T_candidate_query_guess);
@@ -235,6 +243,10 @@ std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
   out.reserve(impl_->times.size());
   for (std::size_t i = 0; i < impl_->times.size(); ++i) out.push_back(impl_->graph.pose(static_cast<int>(i)));
   return out;
+}
+
+bool LoopClosure::searched(std::size_t index) const {
+  return index < impl_->searched.size() && impl_->searched[index];
 }
 
 const std::vector<LoopEvent>& LoopClosure::events() const { return impl_->events; }

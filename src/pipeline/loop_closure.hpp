@@ -53,6 +53,7 @@ struct LoopEvent {
   int shift = 0;                         // [sectors]
   double sc_yaw = 0;                     // [rad] yaw of the query in the candidate frame from the shift
   bool narrowed = false, fell_back = false;
+  int full_shift = -1;                   // the full search's shift on the same descriptors (to compare; -1: radius)
   loop::LoopVerification verification;
   double graph_initial_cost = 0, graph_final_cost = 0, graph_ms = 0;  // of the re-solve (accepted only)
   double correction = 0;  // [m] how far the re-solve moved the query keyframe
@@ -80,6 +81,7 @@ class LoopClosure {
   bool addKeyframe(const lidar::LocalMap& map, std::size_t index, const geometry::Matrix6d& degenerate_cov);
 
   std::vector<Eigen::Isometry3d> poses() const;  // T_world_lidar of every keyframe from the graph, by index
+  bool searched(std::size_t index) const;        // keyframe `index` was queried for loops (not skipped)
   const std::vector<LoopEvent>& events() const;
   const LoopStats& stats() const;
   const LoopClosureConfig& config() const;
