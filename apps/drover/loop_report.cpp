@@ -58,7 +58,9 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
          {"graph_ms", e.graph_ms},
          {"graph_initial_cost", e.graph_initial_cost},
          {"graph_final_cost", e.graph_final_cost},
-         {"trajectory_correction_m", e.correction}};
+         {"trajectory_correction_m", e.correction},
+         {"implied_drift_m", e.implied_drift},
+         {"drift_budget_m", e.drift_budget}};
   correct = false;
   const auto a = truth.lidarAt(e.t_candidate), b = truth.lidarAt(e.t_query);
   if (a && b) {
@@ -110,6 +112,7 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry) {
          {"candidates", s.candidates},
          {"verified", s.verified},
          {"accepted", s.accepted},
+         {"over_drift_budget", s.over_drift_budget},
          {"narrowed_searches", s.narrowed_searches},
          {"fallbacks", s.fallbacks},
          {"descriptor_ms_total", s.descriptor_ms},

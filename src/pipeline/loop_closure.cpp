@@ -42,9 +42,14 @@ std::string LoopClosureConfig::validate() const {
   if (std::string e = database.validate(); !e.empty()) return "database: " + e;
   if (std::string e = verifier.validate(); !e.empty()) return "verifier: " + e;
   if (std::string e = graph.validate(); !e.empty()) return "graph: " + e;
-  const double positive[] = {radius, odometry_sigma_position, odometry_sigma_rotation, degenerate_sigma};
+  const double positive[] = {radius, odometry_sigma_position, odometry_sigma_rotation, degenerate_sigma,
+                             max_drift_floor};
   for (double v : positive)
-    if (!std::isfinite(v) || v <= 0) return "radius, odometry_sigma_* and degenerate_sigma must be finite and > 0";
+    if (!std::isfinite(v) || v <= 0)
+      return "radius, odometry_sigma_*, degenerate_sigma and max_drift_floor must be finite and > 0";
+  if (!std::isfinite(max_drift_ratio) || max_drift_ratio < 0 || !std::isfinite(degenerate_drift) ||
+      degenerate_drift < 0)
+    return "max_drift_ratio and degenerate_drift must be finite and >= 0";
   if (!std::isfinite(min_age) || min_age < 0) return "min_age must be finite and >= 0 s";
   if (submap_keyframes < 0 || max_verifications < 1 || skip_after_loop < 0)
     return "submap_keyframes and skip_after_loop must be >= 0, max_verifications >= 1";
@@ -58,6 +63,7 @@ struct LoopClosure::Impl {
   backend::PoseGraph graph;
   std::vector<Time> times;
   std::vector<bool> searched;  // by keyframe
+  std::vector<double> degenerate_before;  // by keyframe: degenerate directions reported up to it (cumulative)
   std::vector<LoopEvent> events;
   LoopStats stats;
   int skip = 0;
@@ -71,6 +77,7 @@ struct LoopClosure::Impl {
   std::optional<Candidate> radiusCandidate(const lidar::LocalMap& map, std::size_t index) const;
   bool tryCandidate(const lidar::LocalMap& map, std::size_t index, const Candidate& c,
                     const loop::AugmentedScanContext& query);
+  void checkDriftBudget(const lidar::LocalMap& map, LoopEvent& e);
 };
 
 LoopClosure::LoopClosure(const LoopClosureConfig& config) {
@@ -104,6 +111,8 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   const lidar::Keyframe& kf = map.keyframe(index);
   m.times.push_back(kf.t);
   m.searched.push_back(false);
+  m.degenerate_before.push_back((m.degenerate_before.empty() ? 0.0 : m.degenerate_before.back()) +
+                                degenerate_cov.trace());
   m.graph.addNode(static_cast<int>(index), kf.T_world_lidar);
   if (index > 0) m.addOdometryEdge(map, index, degenerate_cov);
   if (!m.config.enabled) return false;
@@ -215,6 +224,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
   e.verification = verifier.verify(map.keyframe(index).features, submap, candidate_in_submap, c.T_candidate_query_guess);
   stats.verify_ms += msSince(t0);
   ++stats.verified;
+  if (e.verification.accepted) checkDriftBudget(map, e);
   if (e.verification.accepted) {
     const Eigen::Vector3d before = graph.pose(static_cast<int>(index)).translation();
     const std::size_t edge = graph.addEdge(static_cast<int>(c.index), static_cast<int>(index),
@@ -236,6 +246,23 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
   }
   events.push_back(e);
   return e.verification.accepted;
+}
+
+// Rejects a verified loop that would move the query further than the odometry can have drifted (see the config).
+void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& e) {
+  double path = 0;
+  for (std::size_t i = e.candidate + 1; i <= e.query; ++i)
+    path += (map.keyframe(i).T_world_lidar.translation() - map.keyframe(i - 1).T_world_lidar.translation()).norm();
+  const Eigen::Isometry3d T_est = map.keyframe(e.candidate).T_world_lidar.inverse() * map.keyframe(e.query).T_world_lidar;
+  e.implied_drift = (e.verification.T_candidate_query.translation() - T_est.translation()).norm();
+  e.drift_budget = config.max_drift_floor + config.max_drift_ratio * path +
+                   config.degenerate_drift * (degenerate_before[e.query] - degenerate_before[e.candidate]);
+  if (e.implied_drift <= e.drift_budget) return;
+  ++stats.over_drift_budget;
+  e.verification.accepted = false;
+  e.verification.reason = fmt::format("rejected: the loop moves the query {:.2f} m from the estimate, more than the "
+                                      "drift budget {:.2f} m over {:.1f} m of path ({})",
+                                      e.implied_drift, e.drift_budget, path, e.verification.reason);
 }
 
 std::vector<Eigen::Isometry3d> LoopClosure::poses() const {

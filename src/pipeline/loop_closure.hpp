@@ -40,6 +40,13 @@ struct LoopClosureConfig {
   double odometry_sigma_position = 0.02;   // [m] per keyframe step
   double odometry_sigma_rotation = 0.002;  // [rad] per keyframe step
   double degenerate_sigma = 0.5;  // [m or rad] per degenerate sweep, along its degenerate directions
+  // Drift budget: a verified loop is accepted only if it moves the query (relative to the candidate) by at most
+  // max_drift_floor + max_drift_ratio * (path length between them) + degenerate_drift * (degenerate directions
+  // reported by the sweeps between them). A loop that needs more than the odometry can have drifted is a false
+  // one (a repeated structure: identical pens, a symmetric hall), however well the scans fit.
+  double max_drift_floor = 2.0;    // [m]
+  double max_drift_ratio = 0.15;   // [-] of the path length
+  double degenerate_drift = 0.5;   // [m] per degenerate direction of a sweep
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };
@@ -57,12 +64,14 @@ struct LoopEvent {
   loop::LoopVerification verification;
   double graph_initial_cost = 0, graph_final_cost = 0, graph_ms = 0;  // of the re-solve (accepted only)
   double correction = 0;  // [m] how far the re-solve moved the query keyframe
+  double implied_drift = 0, drift_budget = 0;  // [m] |loop - estimate| of the relative translation, and its limit
 };
 
 struct LoopStats {
   std::size_t queries = 0;           // keyframes searched
   std::size_t candidates = 0;        // Scan Context candidates under the threshold, plus radius candidates
   std::size_t verified = 0, accepted = 0;
+  std::size_t over_drift_budget = 0;  // verified by scan matching but rejected by the drift budget
   std::size_t narrowed_searches = 0, fallbacks = 0;  // prior-narrowed shift searches, and their fall-backs
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
 };

@@ -3,51 +3,17 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <random>
 
 #include "loop/loop_verifier.hpp"
+#include "support/courtyard.hpp"
 
 namespace drover::loop {
 namespace {
 
-// Features of a courtyard seen from the origin (world = this lidar frame): ground and four walls as plane points,
-// poles and wall corners as edge points. `variant` moves the walls and poles to make another place.
-lidar::FeatureSet courtyard(int variant) {
-  lidar::FeatureSet f;
-  std::mt19937 rng(42 + variant);
-  std::uniform_real_distribution<float> u(-1, 1);
-  const float w = 12.0f + 3.0f * variant, l = 9.0f + 4.0f * variant;
-  for (float x = -w; x <= w; x += 0.4f)
-    for (float y = -l; y <= l; y += 0.4f) f.planes.emplace_back(x, y, -1.8f + 0.002f * u(rng));
-  for (float s = -1; s <= 1; s += 0.02f)
-    for (float z = -1.8f; z <= 3.0f; z += 0.4f) {
-      f.planes.emplace_back(w, s * l, z);
-      f.planes.emplace_back(-w, s * l * 0.8f, z);
-      f.planes.emplace_back(s * w, l, z);
-      f.planes.emplace_back(s * w * 0.7f, -l, z);
-    }
-  const Eigen::Vector2f poles[] = {{4, 3}, {-5, 2}, {6, -4}, {-3, -6}, {1, 7}};
-  for (const Eigen::Vector2f& p : poles)
-    for (float z = -1.8f; z <= 2.0f; z += 0.1f) f.edges.emplace_back(p.x() + variant, p.y() - variant, z);
-  f.full = f.planes;
-  return f;
-}
+using test::courtyard;
+using test::seenFrom;
 
-lidar::FeatureSet seenFrom(const lidar::FeatureSet& world, const Eigen::Isometry3d& T_world_lidar) {
-  const Eigen::Isometry3f T = T_world_lidar.inverse().cast<float>();
-  lidar::FeatureSet f;
-  for (const auto& p : world.edges) f.edges.push_back(T * p);
-  for (const auto& p : world.planes) f.planes.push_back(T * p);
-  f.full = f.planes;
-  return f;
-}
-
-Eigen::Isometry3d pose(double x, double y, double yaw_deg) {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  T.translation() << x, y, 0.0;
-  return T;
-}
+Eigen::Isometry3d pose(double x, double y, double yaw_deg) { return test::planarPose(x, y, yaw_deg); }
 
 TEST(LoopVerifier, RecoversTheTrueRelativePoseFromAScanContextSizedGuessError) {
   const lidar::FeatureSet candidate = courtyard(0);

@@ -16,6 +16,9 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("odometry_sigma_position", c.odometry_sigma_position)
       .bind("odometry_sigma_rotation", c.odometry_sigma_rotation)
       .bind("degenerate_sigma", c.degenerate_sigma)
+      .bind("max_drift_floor", c.max_drift_floor)
+      .bind("max_drift_ratio", c.max_drift_ratio)
+      .bind("degenerate_drift", c.degenerate_drift)
       .nested("scan_context",
               [&](YamlSection& n) {
                 n.bind("rings", d.rings)
