@@ -25,7 +25,7 @@ using Clock = std::chrono::steady_clock;
 
 struct RunOptions {
   std::string dataset, format, config, out;
-  bool no_imu = false, no_camera = false, quiet = false;
+  bool no_imu = false, no_camera = false, no_loop = false, quiet = false;
   double start = 0, duration = 0;  // [s] from the first measurement; duration 0 = to the end
   std::size_t max_frames = 0;      // KITTI odometry: first N frames only
 };
@@ -84,11 +84,12 @@ void runOdometry(const RunOptions& o) {
   checkOptions(o);
   pipeline::OdometryConfig config = o.config.empty() ? pipeline::OdometryConfig{} : io::loadOdometryConfig(o.config);
   if (o.no_imu) config.use_imu = false;
+  if (o.no_loop) config.loop.enabled = false;
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, datasetOptions(o));
   const io::GroundTruth& gt = reader->groundTruth();
   pipeline::LidarOdometry odometry(config, reader->calibration());
-  spdlog::info("drover run: {} ({}), {} -> {}", reader->describe(), o.format,
-               config.use_imu ? "lidar + IMU" : "lidar only", o.out);
+  spdlog::info("drover run: {} ({}), {}{} -> {}", reader->describe(), o.format,
+               config.use_imu ? "lidar + IMU" : "lidar only", config.loop.enabled ? ", loop closure" : "", o.out);
 
   const double gt_span = gt.poses.size() > 1 ? toSeconds(gt.poses.back().t - gt.poses.front().t) : 0.0;
   const double total = o.duration > 0 ? (gt_span > 0 ? std::min(o.duration, gt_span - o.start) : o.duration)
@@ -132,6 +133,7 @@ void registerRun(CLI::App& app) {
   cmd->add_option("--config", o->config, "Platform config (config/kitti.yaml, farm_sim.yaml, ...)");
   cmd->add_option("--out", o->out, "Run folder (created; files in it are replaced)")->required();
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
+  cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");
   cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera (the LIS does not use it yet either way)");
   cmd->add_option("--start", o->start, "Skip the first S seconds of the dataset");
   cmd->add_option("--duration", o->duration, "Process S seconds after --start (0 = to the end)");
