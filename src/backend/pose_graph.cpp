@@ -266,6 +266,7 @@ PoseGraphResult PoseGraph::optimize() {
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.max_num_iterations = impl_->config.max_iterations;
+  options.initial_trust_region_radius = impl_->config.initial_trust_region_radius;
   options.function_tolerance = impl_->config.function_tolerance;
   options.gradient_tolerance = impl_->config.gradient_tolerance;
   options.parameter_tolerance = impl_->config.parameter_tolerance;

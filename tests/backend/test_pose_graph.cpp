@@ -301,6 +301,9 @@ TEST(PoseGraphConfig, ValidateNamesTheBadValueAndTheConstructorRejectsIt) {
   c.loop_loss_scale = -1;
   EXPECT_NE(c.validate().find("loop_loss_scale"), std::string::npos);
   c = {};
+  c.initial_trust_region_radius = 0;
+  EXPECT_NE(c.validate().find("initial_trust_region_radius"), std::string::npos);
+  c = {};
   c.threads = 0;
   EXPECT_NE(c.validate().find("threads"), std::string::npos);
   c = {};
