@@ -235,6 +235,25 @@ TEST(PoseGraph, AGraphWithoutEdgesHasNothingToOptimise) {
   EXPECT_NE(r.reason.find("nothing to optimise"), std::string::npos);
 }
 
+TEST(PoseGraph, AllNodesFixedOrNoneFixedStillGivesAUsableAnswer) {
+  NoisyLoop all;
+  all.addTrueLoop();
+  for (int k = 0; k < 40; ++k) all.graph.setFixed(k, true);
+  const double before = all.graph.cost();
+  const PoseGraphResult r = all.graph.optimize();
+  EXPECT_TRUE(r.usable) << r.reason;
+  EXPECT_EQ(all.graph.cost(), before);
+
+  NoisyLoop none;  // no gauge: the solution is defined up to a rigid motion, the cost still goes down
+  none.addTrueLoop();
+  none.graph.setFixed(0, false);
+  const PoseGraphResult free = none.graph.optimize();
+  EXPECT_TRUE(free.usable) << free.reason;
+  NoisyLoop gauge;
+  gauge.addTrueLoop();
+  EXPECT_NEAR(free.final_cost, gauge.graph.optimize().final_cost, 1e-6 * free.final_cost);
+}
+
 template <typename F>
 void expectInvalid(F&& f, const std::string& fragment) {
   try {
