@@ -162,7 +162,7 @@ PoseGraph& PoseGraph::operator=(PoseGraph&&) noexcept = default;
 void PoseGraph::addNode(int id, const Eigen::Isometry3d& T_world_node) {
   if (hasNode(id)) throw std::invalid_argument("PoseGraph::addNode: duplicate node id " + idText(id));
   checkPose(T_world_node, "PoseGraph::addNode: pose of node " + idText(id));
-  const bool first = impl_->nodes.empty() && impl_->edges.empty();
+  const bool first = impl_->nodes.empty();
   NodeBlock& n = impl_->nodes[id];
   n.set(T_world_node);
   impl_->problem.AddParameterBlock(n.p, 3);

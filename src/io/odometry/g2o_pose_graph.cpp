@@ -50,7 +50,7 @@ backend::PoseGraph toPoseGraph(const G2oGraph& g2o, const backend::PoseGraphConf
       line = v.line;
       graph.addNode(v.id, v.T_world_vertex);
     }
-    if (!g2o.fixed.empty()) {
+    if (!g2o.fixed.empty() && !g2o.vertices.empty()) {
       graph.setFixed(g2o.vertices.front().id, false);
       for (const int id : g2o.fixed) graph.setFixed(id, true);
     }
