@@ -162,7 +162,7 @@ PoseGraph& PoseGraph::operator=(PoseGraph&&) noexcept = default;
 void PoseGraph::addNode(int id, const Eigen::Isometry3d& T_world_node) {
   if (hasNode(id)) throw std::invalid_argument("PoseGraph::addNode: duplicate node id " + idText(id));
   checkPose(T_world_node, "PoseGraph::addNode: pose of node " + idText(id));
-  const bool first = impl_->nodes.empty() && impl_->edges.empty();
+  const bool first = impl_->nodes.empty();
   NodeBlock& n = impl_->nodes[id];
   n.set(T_world_node);
   impl_->problem.AddParameterBlock(n.p, 3);
@@ -266,6 +266,7 @@ PoseGraphResult PoseGraph::optimize() {
   options.minimizer_type = ceres::TRUST_REGION;
   options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
   options.max_num_iterations = impl_->config.max_iterations;
+  options.initial_trust_region_radius = impl_->config.initial_trust_region_radius;
   options.function_tolerance = impl_->config.function_tolerance;
   options.gradient_tolerance = impl_->config.gradient_tolerance;
   options.parameter_tolerance = impl_->config.parameter_tolerance;

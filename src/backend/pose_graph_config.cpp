@@ -21,6 +21,8 @@ std::string PoseGraphConfig::validate() const {
     return "gradient_tolerance = " + std::to_string(gradient_tolerance) + " must be finite and > 0";
   if (!positiveFinite(parameter_tolerance))
     return "parameter_tolerance = " + std::to_string(parameter_tolerance) + " must be finite and > 0";
+  if (!positiveFinite(initial_trust_region_radius))
+    return "initial_trust_region_radius = " + std::to_string(initial_trust_region_radius) + " must be finite and > 0";
   if (!positiveFinite(loop_loss_scale))
     return "loop_loss_scale = " + std::to_string(loop_loss_scale) + " must be finite and > 0";
   if (threads < 1) return "threads = " + std::to_string(threads) + " must be >= 1";
