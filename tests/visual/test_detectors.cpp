@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "visual/detector_factory.hpp"
+#include "visual/image_darkening.hpp"
 #include "visual/keypoint_coverage.hpp"
 
 namespace drover::visual {
@@ -129,6 +130,28 @@ TEST(GridCoverage, CountsOccupiedCells) {
   EXPECT_DOUBLE_EQ(gridCoverage(every, img), 1.0);
   EXPECT_DOUBLE_EQ(gridCoverage({{-5, 3}, {200, 3}}, img), 0.0);
   EXPECT_THROW(gridCoverage({}, cv::Size(0, 10)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace drover::visual
+
+namespace drover::visual {
+namespace {
+
+TEST(DarkenImage, ScalesTheMeanAndAddsTheStatedNoise) {
+  const cv::Mat flat(200, 200, CV_8UC1, cv::Scalar(160));
+  DarkeningConfig cfg;  // 0.25, shot gain 1, read sigma 2
+  const cv::Mat dark = darkenImage(flat, cfg);
+  cv::Scalar mean, sd;
+  cv::meanStdDev(dark, mean, sd);
+  EXPECT_NEAR(mean[0], 40.0, 0.2);
+  EXPECT_NEAR(sd[0], std::sqrt(40.0 + 4.0), 0.3);  // shot variance 40 + read variance 4 (+ rounding 1/12)
+  EXPECT_EQ(cv::norm(dark, darkenImage(flat, cfg), cv::NORM_INF), 0.0);  // seeded
+  cfg.seed = 2;
+  EXPECT_GT(cv::norm(dark, darkenImage(flat, cfg), cv::NORM_INF), 0.0);
+  cfg.scale = 0;
+  EXPECT_THROW(darkenImage(flat, cfg), std::invalid_argument);
+  EXPECT_THROW(darkenImage(cv::Mat(10, 10, CV_8UC3), DarkeningConfig{}), std::invalid_argument);
 }
 
 }  // namespace
