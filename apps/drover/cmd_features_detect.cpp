@@ -103,7 +103,8 @@ void runDetect(const DetectOptions& o) {
     total_ms += ms;
     total_cov += coverage;
     spdlog::info("{}: {} keypoints, coverage {:.3f}, {:.1f} ms", o.images[i], k.points.size(), coverage, ms);
-    images.push_back({{"path", o.images[i]}, {"count", k.points.size()}, {"coverage", coverage}, {"ms", ms}});
+    images.push_back({{"path", o.images[i]}, {"count", k.points.size()}, {"coverage", coverage}, {"ms", ms},
+                      {"mean_intensity", cv::mean(image)[0]}});
     if (!o.draw.empty()) drawKeypoints(drawPath(o.draw, i, o.images.size()), image, k);
   }
   const double n = static_cast<double>(o.images.size());
@@ -132,7 +133,7 @@ void registerFeaturesDetect(CLI::App& features) {
   cmd->add_option("--input-size", o->input_size, "SuperPoint network input WxH, multiples of 8 (default: the image)");
   cmd->add_option("--max", o->max, "At most N keypoints per image (default: the detector's cap)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--json", o->json, "Also write {detector, settings, images: [{path, count, coverage, ms}]}");
+  cmd->add_option("--json", o->json, "Also write {detector, settings, images: [{path, count, coverage, ms, mean_intensity}]}");
   cmd->add_option("--draw", o->draw, "Write the image with its keypoints (several images: OUT_<index>.png)");
   cmd->add_option("--darken", o->darken,
                   "Detect on a darkened copy: exposure x SCALE, shot noise (1 grey level/e-) and read noise "
