@@ -19,6 +19,10 @@ Usage:
 then point Drover at it: `drover features detect --weights superpoint_v1.onnx ...` or the config key
 visual.detector.superpoint.weights.
 
+Checked here (python3-torch installed by hand, not in CI): a state_dict rebuilt from the tensors of
+../shared/models/superpoint_v1.onnx, converted by this script, gives the same keypoints (count and coverage) as the
+shared file on a KITTI and a EuRoC frame (`drover features detect --weights ...`).
+
 Licence: MagicLeap's pretrained weights are for non-commercial research use only; converting them does not change
 that. Weights you trained yourself are yours.
 """
@@ -69,7 +73,10 @@ class SuperPointNet(torch.nn.Module):
 
 
 def load_state_dict(path):
-    sd = torch.load(path, map_location="cpu")
+    try:
+        sd = torch.load(path, map_location="cpu")
+    except Exception as e:  # pickle, zip and IO errors alike: one clear line
+        sys.exit("superpoint_to_onnx: %s is not a readable PyTorch file (%s: %s)" % (path, type(e).__name__, e))
     if isinstance(sd, dict) and "state_dict" in sd and isinstance(sd["state_dict"], dict):
         sd = sd["state_dict"]  # a training checkpoint
     if not isinstance(sd, dict):
