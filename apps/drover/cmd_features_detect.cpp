@@ -7,9 +7,9 @@
 #include <chrono>
 #include <filesystem>
 #include <limits>
-#include <sstream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -30,8 +30,8 @@ using Json = nlohmann::ordered_json;
 struct DetectOptions {
   std::vector<std::string> images;
   std::string detector, config, weights, json, draw, input_size;
-  int max = -1;          // -1 = the detector's own cap
-  double darken = 0;     // 0 = off; else the exposure factor (visual/image_darkening.hpp)
+  int max = -1;       // -1 = the detector's own cap
+  double darken = 0;  // 0 = off; else the exposure factor (visual/image_darkening.hpp)
   std::uint64_t seed = 1;
 };
 
@@ -55,16 +55,24 @@ visual::DetectorConfig detectorConfig(const DetectOptions& o) {
 Json settingsJson(const visual::DetectorConfig& c) {
   switch (c.type) {
     case visual::DetectorType::kShiTomasi:
-      return {{"max_cnt", c.shi_tomasi.max_cnt}, {"min_dist", c.shi_tomasi.min_dist},
-              {"quality_level", c.shi_tomasi.quality_level}, {"block_size", c.shi_tomasi.block_size}};
+      return {{"max_cnt", c.shi_tomasi.max_cnt},
+              {"min_dist", c.shi_tomasi.min_dist},
+              {"quality_level", c.shi_tomasi.quality_level},
+              {"block_size", c.shi_tomasi.block_size}};
     case visual::DetectorType::kOrb:
-      return {{"n_features", c.orb.n_features}, {"scale_factor", c.orb.scale_factor}, {"n_levels", c.orb.n_levels},
-              {"fast_threshold", c.orb.fast_threshold}, {"edge_threshold", c.orb.edge_threshold}};
+      return {{"n_features", c.orb.n_features},
+              {"scale_factor", c.orb.scale_factor},
+              {"n_levels", c.orb.n_levels},
+              {"fast_threshold", c.orb.fast_threshold},
+              {"edge_threshold", c.orb.edge_threshold}};
     case visual::DetectorType::kSuperPoint:
-      return {{"weights", c.superpoint.weights}, {"input_width", c.superpoint.input_width},
-              {"input_height", c.superpoint.input_height}, {"max_keypoints", c.superpoint.max_keypoints},
+      return {{"weights", c.superpoint.weights},
+              {"input_width", c.superpoint.input_width},
+              {"input_height", c.superpoint.input_height},
+              {"max_keypoints", c.superpoint.max_keypoints},
               {"confidence_threshold", c.superpoint.post.confidence_threshold},
-              {"nms_radius", c.superpoint.post.nms_radius}, {"border", c.superpoint.post.border}};
+              {"nms_radius", c.superpoint.post.nms_radius},
+              {"border", c.superpoint.post.border}};
   }
   return {};
 }
@@ -103,7 +111,10 @@ void runDetect(const DetectOptions& o) {
     total_ms += ms;
     total_cov += coverage;
     spdlog::info("{}: {} keypoints, coverage {:.3f}, {:.1f} ms", o.images[i], k.points.size(), coverage, ms);
-    images.push_back({{"path", o.images[i]}, {"count", k.points.size()}, {"coverage", coverage}, {"ms", ms},
+    images.push_back({{"path", o.images[i]},
+                      {"count", k.points.size()},
+                      {"coverage", coverage},
+                      {"ms", ms},
                       {"mean_intensity", cv::mean(image)[0]}});
     if (!o.draw.empty()) drawKeypoints(drawPath(o.draw, i, o.images.size()), image, k);
   }
@@ -121,10 +132,9 @@ void runDetect(const DetectOptions& o) {
 
 void registerFeaturesDetect(CLI::App& features) {
   auto o = std::make_shared<DetectOptions>();
-  auto* cmd = features.add_subcommand(
-      "detect", "Detect keypoints in images: count, coverage of a 16x12 grid, ms per image");
-  cmd->add_option("images", o->images, "Image files (8/16-bit, grey or colour; converted to 8-bit grey)")
-      ->required();
+  auto* cmd =
+      features.add_subcommand("detect", "Detect keypoints in images: count, coverage of a 16x12 grid, ms per image");
+  cmd->add_option("images", o->images, "Image files (8/16-bit, grey or colour; converted to 8-bit grey)")->required();
   cmd->add_option("--detector", o->detector, "superpoint | shi-tomasi | orb (default: the config's, else superpoint)")
       ->check(CLI::IsMember({"superpoint", "shi-tomasi", "orb"}));
   cmd->add_option("--config", o->config, "Platform config: its visual.detector section (config/*.yaml)");
@@ -133,7 +143,8 @@ void registerFeaturesDetect(CLI::App& features) {
   cmd->add_option("--input-size", o->input_size, "SuperPoint network input WxH, multiples of 8 (default: the image)");
   cmd->add_option("--max", o->max, "At most N keypoints per image (default: the detector's cap)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--json", o->json, "Also write {detector, settings, images: [{path, count, coverage, ms, mean_intensity}]}");
+  cmd->add_option("--json", o->json,
+                  "Also write {detector, settings, images: [{path, count, coverage, ms, mean_intensity}]}");
   cmd->add_option("--draw", o->draw, "Write the image with its keypoints (several images: OUT_<index>.png)");
   cmd->add_option("--darken", o->darken,
                   "Detect on a darkened copy: exposure x SCALE, shot noise (1 grey level/e-) and read noise "

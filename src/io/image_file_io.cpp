@@ -19,9 +19,12 @@ cv::Mat readGreyImage(const std::string& path) {
   if (m.empty()) fail(path, "", "not a readable image");
   if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 256.0);
   if (m.depth() != CV_8U) fail(path, "", "unsupported pixel depth (expected 8 or 16 bit)");
-  if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
-  else if (m.channels() == 4) cv::cvtColor(m, m, cv::COLOR_BGRA2GRAY);
-  else if (m.channels() != 1) fail(path, "", "unsupported channel count " + std::to_string(m.channels()));
+  if (m.channels() == 3)
+    cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
+  else if (m.channels() == 4)
+    cv::cvtColor(m, m, cv::COLOR_BGRA2GRAY);
+  else if (m.channels() != 1)
+    fail(path, "", "unsupported channel count " + std::to_string(m.channels()));
   return m;
 }
 

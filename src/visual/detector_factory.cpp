@@ -6,9 +6,12 @@ namespace drover::visual {
 
 std::string detectorTypeName(DetectorType t) {
   switch (t) {
-    case DetectorType::kSuperPoint: return "superpoint";
-    case DetectorType::kShiTomasi: return "shi-tomasi";
-    case DetectorType::kOrb: return "orb";
+    case DetectorType::kSuperPoint:
+      return "superpoint";
+    case DetectorType::kShiTomasi:
+      return "shi-tomasi";
+    case DetectorType::kOrb:
+      return "orb";
   }
   return "unknown";
 }
@@ -22,18 +25,24 @@ DetectorType parseDetectorType(const std::string& name) {
 
 std::string DetectorConfig::validate() const {
   switch (type) {
-    case DetectorType::kSuperPoint: return superpoint.validate();
-    case DetectorType::kShiTomasi: return shi_tomasi.validate();
-    case DetectorType::kOrb: return orb.validate();
+    case DetectorType::kSuperPoint:
+      return superpoint.validate();
+    case DetectorType::kShiTomasi:
+      return shi_tomasi.validate();
+    case DetectorType::kOrb:
+      return orb.validate();
   }
   return "unknown detector type";
 }
 
 std::unique_ptr<KeypointDetector> makeDetector(const DetectorConfig& config) {
   switch (config.type) {
-    case DetectorType::kSuperPoint: return std::make_unique<SuperPointDetector>(config.superpoint);
-    case DetectorType::kShiTomasi: return std::make_unique<ShiTomasiDetector>(config.shi_tomasi);
-    case DetectorType::kOrb: return std::make_unique<OrbDetector>(config.orb);
+    case DetectorType::kSuperPoint:
+      return std::make_unique<SuperPointDetector>(config.superpoint);
+    case DetectorType::kShiTomasi:
+      return std::make_unique<ShiTomasiDetector>(config.shi_tomasi);
+    case DetectorType::kOrb:
+      return std::make_unique<OrbDetector>(config.orb);
   }
   throw std::invalid_argument("unknown detector type");
 }

@@ -25,8 +25,8 @@ cv::Mat darkenImage(const cv::Mat& image, const DarkeningConfig& config) {
     uchar* dst = out.ptr<uchar>(y);
     for (int x = 0; x < image.cols; ++x) {
       const double signal = config.scale * src[x];
-      const double v = signal + std::sqrt(config.shot_gain * signal) * rng.gaussian(1.0) +
-                       config.read_sigma * rng.gaussian(1.0);
+      const double v =
+          signal + std::sqrt(config.shot_gain * signal) * rng.gaussian(1.0) + config.read_sigma * rng.gaussian(1.0);
       dst[x] = cv::saturate_cast<uchar>(std::lround(v));
     }
   }

@@ -9,10 +9,10 @@
 namespace drover::visual {
 
 struct DarkeningConfig {
-  double scale = 0.25;        // exposure factor: the mean intensity becomes `scale` of the original (before noise)
-  double shot_gain = 1.0;     // [grey levels per photo-electron]: shot-noise variance = shot_gain * signal [DN^2]
-  double read_sigma = 2.0;    // [grey levels] Gaussian read noise
-  std::uint64_t seed = 1;     // the same seed gives the same noise
+  double scale = 0.25;           // exposure factor: the mean intensity becomes `scale` of the original (before noise)
+  double shot_gain = 1.0;        // [grey levels per photo-electron]: shot-noise variance = shot_gain * signal [DN^2]
+  double read_sigma = 2.0;       // [grey levels] Gaussian read noise
+  std::uint64_t seed = 1;        // the same seed gives the same noise
   std::string validate() const;  // empty = valid
 };
 

@@ -9,11 +9,11 @@
 namespace drover::visual {
 
 struct OrbConfig {
-  int n_features = 500;       // at most this many keypoints per image; the caller may ask fewer
-  double scale_factor = 1.2;  // pyramid decimation ratio (> 1)
-  int n_levels = 8;           // pyramid levels
-  int fast_threshold = 20;    // [grey levels] FAST intensity threshold
-  int edge_threshold = 31;    // [px] border without keypoints (>= the descriptor patch size, 31)
+  int n_features = 500;          // at most this many keypoints per image; the caller may ask fewer
+  double scale_factor = 1.2;     // pyramid decimation ratio (> 1)
+  int n_levels = 8;              // pyramid levels
+  int fast_threshold = 20;       // [grey levels] FAST intensity threshold
+  int edge_threshold = 31;       // [px] border without keypoints (>= the descriptor patch size, 31)
   std::string validate() const;  // empty = valid
 };
 

@@ -8,10 +8,10 @@
 namespace drover::visual {
 
 struct ShiTomasiConfig {
-  int max_cnt = 150;            // at most this many corners per image (VINS MAX_CNT); the caller may ask fewer
-  double min_dist = 30.0;       // [px] minimum distance between two corners (VINS MIN_DIST)
-  double quality_level = 0.01;  // corners weaker than this fraction of the strongest are dropped (VINS: 0.01)
-  int block_size = 3;           // [px] side of the structure-tensor window
+  int max_cnt = 150;             // at most this many corners per image (VINS MAX_CNT); the caller may ask fewer
+  double min_dist = 30.0;        // [px] minimum distance between two corners (VINS MIN_DIST)
+  double quality_level = 0.01;   // corners weaker than this fraction of the strongest are dropped (VINS: 0.01)
+  int block_size = 3;            // [px] side of the structure-tensor window
   std::string validate() const;  // empty = valid
 };
 

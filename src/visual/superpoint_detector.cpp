@@ -64,8 +64,10 @@ void SuperPointDetector::checkOutputs(cv::Size net_size) const {
     net.forward(outs, kOutputNames);
   } catch (const cv::Exception& e) {
     weightsError(config_.weights, "the network does not run on a 1x1x" + std::to_string(net_size.height) + "x" +
-                                      std::to_string(net_size.width) + " input named 'input' with outputs 'semi' "
-                                      "and 'desc' (" + std::string(e.err) + ")");
+                                      std::to_string(net_size.width) +
+                                      " input named 'input' with outputs 'semi' "
+                                      "and 'desc' (" +
+                                      std::string(e.err) + ")");
   }
   const int hc = net_size.height / 8, wc = net_size.width / 8;
   const int channels[2] = {65, 256};
@@ -107,7 +109,8 @@ void SuperPointDetector::netMask(const cv::Mat& mask, cv::Size net_size) {
     return;
   }
   mask_net_.create(net_size, CV_8U);
-  const double sx = static_cast<double>(mask.cols) / net_size.width, sy = static_cast<double>(mask.rows) / net_size.height;
+  const double sx = static_cast<double>(mask.cols) / net_size.width,
+               sy = static_cast<double>(mask.rows) / net_size.height;
   std::vector<int> xs(net_size.width);
   for (int x = 0; x < net_size.width; ++x) xs[x] = std::min(mask.cols - 1, static_cast<int>((x + 0.5) * sx));
   for (int y = 0; y < net_size.height; ++y) {
@@ -129,7 +132,8 @@ Keypoints SuperPointDetector::detect(const cv::Mat& image, const cv::Mat& mask, 
   Keypoints out = post_.run(outputs_[0], outputs_[1], mask_net_, n);
   if (resize) {
     // Pixel centres map to pixel centres: x_image + 0.5 = (x_net + 0.5) * W_image / W_net.
-    const float sx = static_cast<float>(image.cols) / net_size.width, sy = static_cast<float>(image.rows) / net_size.height;
+    const float sx = static_cast<float>(image.cols) / net_size.width,
+                sy = static_cast<float>(image.rows) / net_size.height;
     for (cv::Point2f& p : out.points) p = {(p.x + 0.5f) * sx - 0.5f, (p.y + 0.5f) * sy - 0.5f};
   }
   return out;

@@ -19,7 +19,7 @@ struct SuperPointConfig {
   // resized to it and the keypoints scaled back to image pixels; smaller = faster (cost ~ width x height).
   int input_width = 0;
   int input_height = 0;
-  int max_keypoints = 1000;  // at most this many per image; the caller may ask fewer
+  int max_keypoints = 1000;   // at most this many per image; the caller may ask fewer
   SuperPointPostConfig post;  // threshold, NMS radius and border, in network pixels
   // Threads OpenCV uses for the forward pass (cv::setNumThreads, a process-wide setting applied at construction);
   // 0 = leave OpenCV's setting.

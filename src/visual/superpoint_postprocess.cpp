@@ -20,8 +20,8 @@ void checkBlob(const cv::Mat& m, const char* name, int channels, int hc, int wc)
   if (!ok)
     throw std::invalid_argument(std::string("superpoint: output '") + name + "' must be a CV_32F blob 1x" +
                                 std::to_string(channels) + "xH/8xW/8" +
-                                (hc < 0 ? "" : " (" + std::to_string(hc) + "x" + std::to_string(wc) + ")") +
-                                ", got " + blobShape(m) + " " + matTypeName(m.type()));
+                                (hc < 0 ? "" : " (" + std::to_string(hc) + "x" + std::to_string(wc) + ")") + ", got " +
+                                blobShape(m) + " " + matTypeName(m.type()));
 }
 
 // Plane c of a 1xCxHxW blob as an HcxWc matrix header (no copy).
@@ -133,9 +133,9 @@ void SuperPointPostprocessor::sampleDescriptors(const cv::Mat& desc, Keypoints& 
   }
 }
 
-Keypoints SuperPointPostprocessor::run(const cv::Mat& semi, const cv::Mat& desc, const cv::Mat& mask,
-                                       int max_count) {
-  if (max_count < 0) throw std::invalid_argument("superpoint: max_count must be >= 0, got " + std::to_string(max_count));
+Keypoints SuperPointPostprocessor::run(const cv::Mat& semi, const cv::Mat& desc, const cv::Mat& mask, int max_count) {
+  if (max_count < 0)
+    throw std::invalid_argument("superpoint: max_count must be >= 0, got " + std::to_string(max_count));
   checkBlob(semi, "semi", kDetChannels, -1, -1);
   const int hc = semi.size[2], wc = semi.size[3];
   if (!desc.empty()) checkBlob(desc, "desc", kDescChannels, hc, wc);

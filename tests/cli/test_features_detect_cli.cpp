@@ -27,8 +27,8 @@ fs::path writeCheckerboard(const TempDir& dir, const std::string& name = "board.
 TEST(FeaturesDetectCli, ShiTomasiFindsTheCheckerboardCornersAndWritesJson) {
   TempDir dir;
   const fs::path board = writeCheckerboard(dir);
-  const CliResult r = runDrover("features detect --detector shi-tomasi " + board.string() + " --json " +
-                                (dir / "out.json").string());
+  const CliResult r =
+      runDrover("features detect --detector shi-tomasi " + board.string() + " --json " + (dir / "out.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "35 keypoints")) << r.output;
   const auto j = readJson(dir / "out.json");
@@ -47,8 +47,8 @@ TEST(FeaturesDetectCli, ShiTomasiFindsTheCheckerboardCornersAndWritesJson) {
 TEST(FeaturesDetectCli, OrbHonoursMaxAndDrawsOneImagePerInput) {
   TempDir dir;
   const fs::path a = writeCheckerboard(dir, "a.png"), b = writeCheckerboard(dir, "b.png");
-  const CliResult r = runDrover("features detect --detector orb --max 5 " + a.string() + " " + b.string() +
-                                " --draw " + (dir / "kp.png").string() + " --json " + (dir / "o.json").string());
+  const CliResult r = runDrover("features detect --detector orb --max 5 " + a.string() + " " + b.string() + " --draw " +
+                                (dir / "kp.png").string() + " --json " + (dir / "o.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = readJson(dir / "o.json");
   ASSERT_EQ(j["images"].size(), 2u);
@@ -63,8 +63,8 @@ TEST(FeaturesDetectCli, OrbHonoursMaxAndDrawsOneImagePerInput) {
 TEST(FeaturesDetectCli, DarkenedCheckerboardLosesCornersAndJsonStatesTheNoiseModel) {
   TempDir dir;
   const fs::path board = writeCheckerboard(dir);
-  const CliResult r = runDrover("features detect --detector shi-tomasi --darken 0.25 " + board.string() +
-                                " --json " + (dir / "d.json").string());
+  const CliResult r = runDrover("features detect --detector shi-tomasi --darken 0.25 " + board.string() + " --json " +
+                                (dir / "d.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = readJson(dir / "d.json");
   EXPECT_EQ(j["darken"]["scale"], 0.25);
@@ -79,9 +79,9 @@ TEST(FeaturesDetectCli, SuperPointOnAKittiFrameAtReducedInputSize) {
   DROVER_REQUIRE_SHARED(model);
   DROVER_REQUIRE_SHARED(image);
   TempDir dir;
-  const CliResult r = runDrover("features detect --config " + std::string(DROVER_SOURCE_DIR) +
-                                "/config/kitti.yaml --weights " + model.string() + " --input-size 616x184 " +
-                                image.string() + " --json " + (dir / "sp.json").string());
+  const CliResult r =
+      runDrover("features detect --config " + std::string(DROVER_SOURCE_DIR) + "/config/kitti.yaml --weights " +
+                model.string() + " --input-size 616x184 " + image.string() + " --json " + (dir / "sp.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = readJson(dir / "sp.json");
   EXPECT_EQ(j["detector"], "superpoint");

@@ -110,8 +110,9 @@ TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {
 
 TEST(VisualConfigReader, ValuesThatFailValidationNameTheSectionAndItsLine) {
   test::TempDir dir;
-  std::string e = errorOf(dir, "visual:\n  detector:\n    type: orb\n    superpoint:\n      input_width: 100\n"
-                               "      input_height: 80\n");
+  std::string e = errorOf(dir,
+                          "visual:\n  detector:\n    type: orb\n    superpoint:\n      input_width: 100\n"
+                          "      input_height: 80\n");
   EXPECT_TRUE(has(e, "line 5")) << e;  // yaml-cpp marks a map by its first key
   EXPECT_TRUE(has(e, "visual.detector.superpoint")) << e;
   EXPECT_TRUE(has(e, "multiples of 8")) << e;

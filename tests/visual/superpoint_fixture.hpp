@@ -23,12 +23,13 @@ inline int makeSuperPointOnnx(const std::filesystem::path& dir, const std::strin
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
-#define DROVER_MAKE_SUPERPOINT_ONNX(dir, variant)                                                              \
-  do {                                                                                                         \
-    const int rc_ = drover::test::makeSuperPointOnnx(dir, variant);                                            \
-    if (rc_ == 77) GTEST_SKIP() << "python3-onnx not installed (scripts/install_deps.sh installs it): the "  \
-                                   "SuperPoint reference test needs /usr/bin/python3 with onnx and numpy"; \
-    ASSERT_EQ(rc_, 0) << "tests/visual/make_superpoint_onnx.py failed";                                       \
+#define DROVER_MAKE_SUPERPOINT_ONNX(dir, variant)                                              \
+  do {                                                                                         \
+    const int rc_ = drover::test::makeSuperPointOnnx(dir, variant);                            \
+    if (rc_ == 77)                                                                             \
+      GTEST_SKIP() << "python3-onnx not installed (scripts/install_deps.sh installs it): the " \
+                      "SuperPoint reference test needs /usr/bin/python3 with onnx and numpy";  \
+    ASSERT_EQ(rc_, 0) << "tests/visual/make_superpoint_onnx.py failed";                        \
   } while (0)
 
 template <typename T>

@@ -135,8 +135,7 @@ TEST(SuperPointPostprocess, DescriptorsAreBilinearBetweenCellCentresAndUnitLengt
 TEST(SuperPointPostprocess, OutputsOfTheWrongShapeAreRejected) {
   SuperPointPostprocessor post;
   const int bad_shape[4] = {1, 64, kHc, kWc};
-  EXPECT_THROW(post.run(cv::Mat(4, bad_shape, CV_32F, cv::Scalar(0)), cv::Mat(), cv::Mat(), 10),
-               std::invalid_argument);
+  EXPECT_THROW(post.run(cv::Mat(4, bad_shape, CV_32F, cv::Scalar(0)), cv::Mat(), cv::Mat(), 10), std::invalid_argument);
   const int desc_shape[4] = {1, 256, kHc, kWc + 1};
   EXPECT_THROW(post.run(emptySemi(), cv::Mat(4, desc_shape, CV_32F, cv::Scalar(0)), cv::Mat(), 10),
                std::invalid_argument);

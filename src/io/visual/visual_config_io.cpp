@@ -49,9 +49,10 @@ void bindDetector(YamlSection& s, visual::DetectorConfig& c, std::string& type) 
 void checkValid(const std::string& file, const YAML::Node& node, const std::string& section, const std::string& err) {
   if (err.empty()) return;
   const int line = node ? node.Mark().line : -1;
-  fail(file, (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "section '" +
-                 section + "'",
-       err);
+  fail(
+      file,
+      (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "section '" + section + "'",
+      err);
 }
 
 }  // namespace
