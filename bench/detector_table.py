@@ -10,7 +10,9 @@ cells holding a keypoint) of SuperPoint, Shi-Tomasi and ORB, with the settings o
 
 Darkened = `drover features detect --darken 0.25`: exposure x 0.25 (the mean intensity becomes 25 %), shot noise
 (Gaussian approximation of Poisson, 1 grey level per photo-electron: variance = signal) and Gaussian read noise of
-sigma 2 grey levels, rounded and clamped to 0..255, seed 1 + image index.
+sigma 2 grey levels, rounded and clamped to 0..255, seed 1 + image index. For darkened images the table also gives
+the repeatability under noise: the same images darkened again with other noise (seed 1001 + index), and the
+fraction of keypoints of the first copy with a keypoint of the second within 2 px (noise corners do not come back).
 
 Usage: bench/detector_table.py [--drover build/apps/drover/drover] [--sim-dir /tmp] [--out table.md]
 The simulated courses are generated when missing (drover sim --scenario lighting|white-walls --duration 20).
@@ -23,22 +25,37 @@ import subprocess
 import sys
 import tempfile
 
+import numpy as np
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.path.join(os.path.dirname(ROOT), "shared")
 DETECTORS = ["superpoint", "shi-tomasi", "orb"]
 
 
-def detect(drover, detector, images, darken=0.0):
+def detect(drover, detector, images, darken=0.0, seed=1):
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "d.json")
         cmd = [drover, "-q", "features", "detect", "--config", os.path.join(ROOT, "bench", "detector_table.yaml"),
                "--detector", detector, "--json", out, "--weights",
                os.path.join(SHARED, "models", "superpoint_v1.onnx")] + images
         if darken:
-            cmd += ["--darken", str(darken)]
+            cmd += ["--darken", str(darken), "--seed", str(seed), "--json-points"]
         subprocess.run(cmd, check=True)
         with open(out) as f:
             return json.load(f)["images"]
+
+
+def repeatability(a, b, radius=2.0):
+    """Mean over images of the fraction of keypoints of `a` with a keypoint of `b` within `radius` px."""
+    fractions = []
+    for ia, ib in zip(a, b):
+        pa, pb = np.array(ia["points"]).reshape(-1, 2), np.array(ib["points"]).reshape(-1, 2)
+        if len(pa) == 0 or len(pb) == 0:
+            fractions.append(0.0)
+            continue
+        d = np.linalg.norm(pa[:, None, :] - pb[None, :, :], axis=2).min(axis=1)
+        fractions.append(float(np.mean(d <= radius)))
+    return sum(fractions) / len(fractions)
 
 
 def simulated(drover, sim_dir, scenario):
@@ -87,15 +104,18 @@ def main():
             ("sim lighting, dark stretch", dark_frames(a.drover, a.sim_dir), 0.0),
             ("sim white-walls", white_wall_frames(a.drover, a.sim_dir), 0.0)]
     lines = ["| images (n) | mean grey | " + " | ".join(
-        "%s count (min) | %s coverage" % (d, d) for d in DETECTORS) + " | SuperPoint ms |",
-        "|---|---:|" + "---:|---:|" * len(DETECTORS) + "---:|"]
+        "%s count (min) | %s coverage | %s repeat." % (d, d, d) for d in DETECTORS) + " | SuperPoint ms |",
+        "|---|---:|" + "---:|---:|---:|" * len(DETECTORS) + "---:|"]
     for name, images, darken in sets:
         cells, grey, sp_ms = [], 0.0, 0.0
         for d in DETECTORS:
             res = detect(a.drover, d, images, darken)
             counts = [r["count"] for r in res]
             cov = sum(r["coverage"] for r in res) / len(res)
-            cells.append("%.0f (%d) | %.2f" % (sum(counts) / len(counts), min(counts), cov))
+            rep = "—"
+            if darken:  # the same darkened images with other noise: do the keypoints come back?
+                rep = "%.2f" % repeatability(res, detect(a.drover, d, images, darken, seed=1001))
+            cells.append("%.0f (%d) | %.2f | %s" % (sum(counts) / len(counts), min(counts), cov, rep))
             grey = sum(r["mean_intensity"] for r in res) / len(res)
             if d == "superpoint":
                 sp_ms = sum(r["ms"] for r in res) / len(res)

@@ -33,6 +33,7 @@ struct DetectOptions {
   int max = -1;       // -1 = the detector's own cap
   double darken = 0;  // 0 = off; else the exposure factor (visual/image_darkening.hpp)
   std::uint64_t seed = 1;
+  bool json_points = false;  // also write every keypoint's [x, y] to the JSON
 };
 
 visual::DetectorConfig detectorConfig(const DetectOptions& o) {
@@ -111,11 +112,17 @@ void runDetect(const DetectOptions& o) {
     total_ms += ms;
     total_cov += coverage;
     spdlog::info("{}: {} keypoints, coverage {:.3f}, {:.1f} ms", o.images[i], k.points.size(), coverage, ms);
-    images.push_back({{"path", o.images[i]},
-                      {"count", k.points.size()},
-                      {"coverage", coverage},
-                      {"ms", ms},
-                      {"mean_intensity", cv::mean(image)[0]}});
+    Json entry = {{"path", o.images[i]},
+                  {"count", k.points.size()},
+                  {"coverage", coverage},
+                  {"ms", ms},
+                  {"mean_intensity", cv::mean(image)[0]}};
+    if (o.json_points) {
+      Json pts = Json::array();
+      for (const cv::Point2f& p : k.points) pts.push_back({p.x, p.y});
+      entry["points"] = std::move(pts);
+    }
+    images.push_back(std::move(entry));
     if (!o.draw.empty()) drawKeypoints(drawPath(o.draw, i, o.images.size()), image, k);
   }
   const double n = static_cast<double>(o.images.size());
@@ -145,6 +152,7 @@ void registerFeaturesDetect(CLI::App& features) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--json", o->json,
                   "Also write {detector, settings, images: [{path, count, coverage, ms, mean_intensity}]}");
+  cmd->add_flag("--json-points", o->json_points, "Also write each image's keypoints [[x, y], ...] to the JSON");
   cmd->add_option("--draw", o->draw, "Write the image with its keypoints (several images: OUT_<index>.png)");
   cmd->add_option("--darken", o->darken,
                   "Detect on a darkened copy: exposure x SCALE, shot noise (1 grey level/e-) and read noise "
