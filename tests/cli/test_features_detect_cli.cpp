@@ -2,6 +2,7 @@
 // on, drawing, darkening, the real SuperPoint on a KITTI frame, and the errors (one line, exit code 2).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 #include "io/image_file_io.hpp"
@@ -28,7 +29,8 @@ TEST(FeaturesDetectCli, ShiTomasiFindsTheCheckerboardCornersAndWritesJson) {
   TempDir dir;
   const fs::path board = writeCheckerboard(dir);
   const CliResult r =
-      runDrover("features detect --detector shi-tomasi " + board.string() + " --json " + (dir / "out.json").string());
+      runDrover("features detect --detector shi-tomasi --json-points " + board.string() + " --json " +
+                (dir / "out.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "35 keypoints")) << r.output;
   const auto j = readJson(dir / "out.json");
@@ -38,10 +40,16 @@ TEST(FeaturesDetectCli, ShiTomasiFindsTheCheckerboardCornersAndWritesJson) {
   const auto& im = j["images"][0];
   EXPECT_EQ(im["path"], board.string());
   EXPECT_EQ(im["count"], 35);
-  // Corners on x = 40..280, y = 40..200: columns 1..14 of 16 (20 px wide) every other one, rows 2..10 of 12.
-  EXPECT_GT(im["coverage"].get<double>(), 0.15);
-  EXPECT_LT(im["coverage"].get<double>(), 0.25);
+  // Cells are 20 x 20 px and corners 40 px apart: each of the 35 corners has a cell of its own.
+  EXPECT_DOUBLE_EQ(im["coverage"].get<double>(), 35.0 / 192.0);
   EXPECT_GT(im["ms"].get<double>(), 0.0);
+  EXPECT_NEAR(im["mean_intensity"].get<double>(), 125.0, 1.0);  // half 30, half 220
+  ASSERT_EQ(im["points"].size(), 35u);
+  for (const auto& p : im["points"]) {
+    // Every corner sits where four squares meet, between pixels 40 k - 1 and 40 k.
+    EXPECT_NEAR(std::fmod(p[0].get<double>() + 0.5 + 20, 40.0), 20.0, 1.5) << p;
+    EXPECT_NEAR(std::fmod(p[1].get<double>() + 0.5 + 20, 40.0), 20.0, 1.5) << p;
+  }
 }
 
 TEST(FeaturesDetectCli, OrbHonoursMaxAndDrawsOneImagePerInput) {

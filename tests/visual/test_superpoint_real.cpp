@@ -1,6 +1,7 @@
 // The pretrained SuperPoint (../shared/models/superpoint_v1.onnx, MagicLeap, non-commercial) on real KITTI and
 // EuRoC frames: sane counts, keypoints spread over the image, descriptors of unit length, and the reduced input
-// size giving a similar spread. Bounds come from the runs recorded in bench/RESULTS.md, with margin.
+// size giving a similar spread. Bounds: measured 755 keypoints / coverage 0.86 (KITTI 00/000000), 558 / 0.57
+// (first EuRoC frame), 337 / 0.72 (KITTI at 616x184), with margin.
 #include <gtest/gtest.h>
 
 #include <filesystem>
