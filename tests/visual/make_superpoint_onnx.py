@@ -14,19 +14,18 @@ Chebyshev distances), border removal, top-k, and vectorised bilinear descriptor 
 Usage: make_superpoint_onnx.py OUT_DIR [--variant ok|semi64|no-desc]
 Writes OUT_DIR/model.onnx, and for the `ok` variant image.u8 (H*W bytes, row-major), meta.txt ("H W N MAX"),
 points.f32 (N x 2: x, y), scores.f32 (N), desc.f32 (N x 256), all little-endian float32.
-Needs Debian's python3-onnx and python3-numpy; exits 77 when onnx is missing (the test then skips).
+Needs Debian's python3-onnx and python3-numpy; exits 77 when either is missing (the test then skips).
 """
 import argparse
 import os
 import sys
 
-import numpy as np
-
 try:
+    import numpy as np
     import onnx
     from onnx import TensorProto, helper, numpy_helper
-except ImportError:
-    print("python3-onnx is not installed (apt-get install python3-onnx)", file=sys.stderr)
+except ImportError as e:
+    print("%s: install python3-onnx and python3-numpy (scripts/install_deps.sh)" % e, file=sys.stderr)
     sys.exit(77)
 
 H, W = 96, 128            # test image [px], multiples of 8
