@@ -1,0 +1,28 @@
+#pragma once
+// The `visual:` section of a platform config (config/*.yaml) -> the visual front end's configs. Every key is
+// optional (left out = the default in the component's Config, whose header gives its unit); an unknown key or a
+// bad value is an IoError naming the file, the line and the dotted key. Sections and keys so far:
+//   visual:
+//     detector:       type (superpoint | shi-tomasi | orb)
+//       shi_tomasi:   max_cnt, min_dist [px], quality_level, block_size [px]  (visual/shi_tomasi_detector.hpp)
+//       orb:          n_features, scale_factor, n_levels, fast_threshold [grey levels], edge_threshold [px]
+//       superpoint:   weights (ONNX file; relative = to the working directory), input_width, input_height [px],
+//                     max_keypoints, confidence_threshold, nms_radius [px], border [px], threads
+// The tracker and depth association will add `visual.tracker` and `visual.depth` beside `detector`: one bind
+// function per sub-section in visual_config_io.cpp, one field in VisualConfig.
+// Lives in its own library (drover_io_visual) so that the readers do not depend on the visual module.
+#include <string>
+
+#include "visual/detector_factory.hpp"
+
+namespace drover::io {
+
+struct VisualConfig {
+  visual::DetectorConfig detector;
+};
+
+// Throws IoError (file, line, key) for a missing file, invalid YAML, unknown key or bad value, and when a
+// sub-section fails its Config::validate() (naming the file, the sub-section's line and the section).
+VisualConfig loadVisualConfig(const std::string& yaml_path);
+
+}  // namespace drover::io

@@ -1,0 +1,132 @@
+// The `visual:` section of a platform config -> io::VisualConfig (io/visual/visual_config_io.hpp): the shipped
+// configs load, every key reaches its own field, and every mistake is an IoError naming the file, the line and the
+// dotted key. (In tests/cli because that test module links drover_io_visual.)
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "io/error.hpp"
+#include "io/visual/visual_config_io.hpp"
+#include "support/temp_dir.hpp"
+
+namespace drover::io {
+namespace {
+
+using visual::DetectorType;
+
+std::string shipped(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
+
+VisualConfig load(const test::TempDir& dir, const std::string& text) {
+  const auto path = dir / "visual.yaml";
+  test::writeText(path, text);
+  return loadVisualConfig(path.string());
+}
+
+std::string errorOf(const test::TempDir& dir, const std::string& text) {
+  try {
+    load(dir, text);
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "expected an IoError for:\n" << text;
+  return {};
+}
+
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(VisualConfigReader, ShippedConfigsChooseSuperPointWithTheSharedWeights) {
+  for (const char* name : {"kitti.yaml", "euroc.yaml", "farm_sim.yaml"}) {
+    SCOPED_TRACE(name);
+    VisualConfig c;
+    ASSERT_NO_THROW(c = loadVisualConfig(shipped(name)));
+    EXPECT_EQ(c.detector.type, DetectorType::kSuperPoint);
+    EXPECT_EQ(c.detector.superpoint.weights, "../shared/models/superpoint_v1.onnx");
+    EXPECT_EQ(c.detector.validate(), "");
+  }
+  EXPECT_DOUBLE_EQ(loadVisualConfig(shipped("euroc.yaml")).detector.shi_tomasi.min_dist, 30.0);
+  EXPECT_EQ(loadVisualConfig(shipped("kitti.yaml")).detector.shi_tomasi.max_cnt, 200);
+}
+
+TEST(VisualConfigReader, AFileWithoutAVisualSectionGivesTheDefaults) {
+  test::TempDir dir;
+  const VisualConfig c = load(dir, "dataset:\n  load_images: true\n");
+  EXPECT_EQ(c.detector.type, DetectorType::kSuperPoint);
+  EXPECT_EQ(c.detector.shi_tomasi.max_cnt, visual::ShiTomasiConfig{}.max_cnt);
+}
+
+TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
+  test::TempDir dir;
+  const VisualConfig c = load(dir, R"(visual:
+  detector:
+    type: orb
+    shi_tomasi: {max_cnt: 11, min_dist: 12.5, quality_level: 0.013, block_size: 5}
+    orb: {n_features: 21, scale_factor: 1.3, n_levels: 4, fast_threshold: 17, edge_threshold: 33}
+    superpoint:
+      weights: /models/sp.onnx
+      input_width: 320
+      input_height: 240
+      max_keypoints: 31
+      confidence_threshold: 0.02
+      nms_radius: 3
+      border: 6
+      threads: 2
+)");
+  const visual::DetectorConfig& d = c.detector;
+  EXPECT_EQ(d.type, DetectorType::kOrb);
+  EXPECT_EQ(d.shi_tomasi.max_cnt, 11);
+  EXPECT_DOUBLE_EQ(d.shi_tomasi.min_dist, 12.5);
+  EXPECT_DOUBLE_EQ(d.shi_tomasi.quality_level, 0.013);
+  EXPECT_EQ(d.shi_tomasi.block_size, 5);
+  EXPECT_EQ(d.orb.n_features, 21);
+  EXPECT_DOUBLE_EQ(d.orb.scale_factor, 1.3);
+  EXPECT_EQ(d.orb.n_levels, 4);
+  EXPECT_EQ(d.orb.fast_threshold, 17);
+  EXPECT_EQ(d.orb.edge_threshold, 33);
+  EXPECT_EQ(d.superpoint.weights, "/models/sp.onnx");
+  EXPECT_EQ(d.superpoint.input_width, 320);
+  EXPECT_EQ(d.superpoint.input_height, 240);
+  EXPECT_EQ(d.superpoint.max_keypoints, 31);
+  EXPECT_DOUBLE_EQ(d.superpoint.post.confidence_threshold, 0.02);
+  EXPECT_EQ(d.superpoint.post.nms_radius, 3);
+  EXPECT_EQ(d.superpoint.post.border, 6);
+  EXPECT_EQ(d.superpoint.threads, 2);
+}
+
+TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {
+  test::TempDir dir;
+  std::string e = errorOf(dir, "visual:\n  detector:\n    superpoint:\n      weigths: x.onnx\n");
+  EXPECT_TRUE(has(e, "visual.yaml")) << e;
+  EXPECT_TRUE(has(e, "line 4")) << e;
+  EXPECT_TRUE(has(e, "visual.detector.superpoint.weigths")) << e;
+  e = errorOf(dir, "visual:\n  detector:\n    type: sift\n");
+  EXPECT_TRUE(has(e, "line 3")) << e;
+  EXPECT_TRUE(has(e, "superpoint, shi-tomasi or orb")) << e;
+  e = errorOf(dir, "visual:\n  detector:\n    orb:\n      n_levels: many\n");
+  EXPECT_TRUE(has(e, "line 4")) << e;
+  EXPECT_TRUE(has(e, "visual.detector.orb.n_levels")) << e;
+  e = errorOf(dir, "visual:\n  detectors: {}\n");
+  EXPECT_TRUE(has(e, "visual.detectors")) << e;
+}
+
+TEST(VisualConfigReader, ValuesThatFailValidationNameTheSectionAndItsLine) {
+  test::TempDir dir;
+  std::string e = errorOf(dir,
+                          "visual:\n  detector:\n    type: orb\n    superpoint:\n      input_width: 100\n"
+                          "      input_height: 80\n");
+  EXPECT_TRUE(has(e, "line 5")) << e;  // yaml-cpp marks a map by its first key
+  EXPECT_TRUE(has(e, "visual.detector.superpoint")) << e;
+  EXPECT_TRUE(has(e, "multiples of 8")) << e;
+  e = errorOf(dir, "visual:\n  detector:\n    shi_tomasi:\n      quality_level: 1.5\n");
+  EXPECT_TRUE(has(e, "visual.detector.shi_tomasi")) << e;
+  EXPECT_TRUE(has(e, "quality_level")) << e;
+  e = errorOf(dir, "visual:\n  detector:\n    orb: {scale_factor: 0.9}\n");
+  EXPECT_TRUE(has(e, "line 3")) << e;
+  EXPECT_TRUE(has(e, "scale_factor")) << e;
+}
+
+TEST(VisualConfigReader, MissingFileIsAnIoError) {
+  EXPECT_THROW(loadVisualConfig("/nonexistent/config.yaml"), IoError);
+}
+
+}  // namespace
+}  // namespace drover::io
