@@ -88,26 +88,42 @@ DatabaseQuery ScanContextDatabase::query(const AugmentedScanContext& q,
     if (d.ring_key.size() != config_.descriptor.rings)
       throw std::invalid_argument("scan context database: query ring key size differs from the config's rings");
 
-  // Union of each virtual position's top-k by ring key, keeping the smallest ring-key distance per entry.
-  std::map<std::uint32_t, float> retrieved;
+  // Each virtual position's top-k by ring key; an entry retrieved by several keeps its smallest ring-key distance
+  // and the position that gave it. The best `candidates` entries overall are then scored, each with the real
+  // position's descriptor and the one that retrieved it (scoring every entry against every position costs 9x).
+  struct Retrieved {
+    float d2;
+    std::size_t position;
+  };
+  std::map<std::uint32_t, Retrieved> retrieved;
   const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(config_.candidates), m.indexed);
   std::vector<std::uint32_t> idx(k);
   std::vector<float> d2(k);
-  for (const ScanContext& d : q.descriptors) {
+  for (std::size_t v = 0; v < q.descriptors.size(); ++v) {
     nanoflann::KNNResultSet<float, std::uint32_t> result(k);
     result.init(idx.data(), d2.data());
-    m.tree->findNeighbors(result, d.ring_key.data(), nanoflann::SearchParams());
+    m.tree->findNeighbors(result, q.descriptors[v].ring_key.data(), nanoflann::SearchParams());
     for (std::size_t i = 0; i < result.size(); ++i) {
-      auto [it, inserted] = retrieved.emplace(idx[i], d2[i]);
-      if (!inserted) it->second = std::min(it->second, d2[i]);
+      auto [it, inserted] = retrieved.emplace(idx[i], Retrieved{d2[i], v});
+      if (!inserted && d2[i] < it->second.d2) it->second = {d2[i], v};
     }
   }
-  for (const auto& [entry, dist2] : retrieved) {
+  std::vector<std::pair<std::uint32_t, Retrieved>> ranked(retrieved.begin(), retrieved.end());
+  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.second.d2 < b.second.d2; });
+  if (ranked.size() > k) ranked.resize(k);
+  for (const auto& [entry, r] : ranked) {
     LoopCandidate c;
     c.id = m.ids[entry];
-    c.ring_key_distance = std::sqrt(static_cast<double>(dist2));
+    c.ring_key_distance = std::sqrt(static_cast<double>(r.d2));
     const std::optional<double> prior = yaw_prior ? yaw_prior(c.id) : std::nullopt;
-    c.match = augmentedShiftSearch(m.descriptors[entry], q, prior, config_.descriptor);
+    AugmentedScanContext positions;  // the real position and the retrieving one
+    for (std::size_t v : {std::size_t{0}, r.position}) {
+      if (v == 0 && !positions.descriptors.empty()) continue;
+      positions.descriptors.push_back(q.descriptors[v]);
+      positions.offsets.push_back(q.offsets.size() > v ? q.offsets[v] : Eigen::Vector2f::Zero());
+    }
+    c.match = augmentedShiftSearch(m.descriptors[entry], positions, prior, config_.descriptor);
+    c.match.index = static_cast<int>(c.match.index == 0 ? 0 : r.position);
     out.shifts_evaluated += c.match.match.evaluated;
     out.candidates.push_back(c);
   }

@@ -6,7 +6,8 @@
 // (Drover's paper, Eqs. 2-4) when the caller gives a yaw prior for the candidate, else the full search.
 //
 // Query descriptors may be laterally augmented (Scan Context++ root shifting, see scan_context.hpp): each
-// virtual position's ring key retrieves its own top-k, the union is scored, and the best virtual position is kept.
+// virtual position's ring key retrieves its own top-k; of their union the top-k by ring-key distance are scored,
+// each with the real position and the virtual position that retrieved it, and the better of the two is kept.
 //
 // Entries become searchable only once `exclude_recent` newer entries exist (the reference implementation's
 // NUM_EXCLUDE_RECENT), so the tree never holds an entry a query may not return. Not thread-safe.
