@@ -23,7 +23,7 @@ void requireSameShape(const ScanContext& a, const ScanContext& b) {
 std::string ScanContextConfig::validate() const {
   if (rings < 1 || sectors < 2) return "rings must be >= 1 and sectors >= 2";
   if (!std::isfinite(max_radius) || max_radius <= 0) return "max_radius must be finite and > 0 m";
-  if (!std::isfinite(sensor_height)) return "sensor_height must be finite";
+  if (!std::isfinite(sensor_height) || !std::isfinite(ground_lift)) return "sensor_height and ground_lift must be finite";
   if (!std::isfinite(threshold) || threshold <= 0 || threshold > 2) return "threshold must be in (0, 2]";
   if (search_radius < 0) return "search_radius must be >= 0";
   if (!std::isfinite(lateral_step) || lateral_step <= 0) return "lateral_step must be finite and > 0 m";
@@ -33,8 +33,9 @@ std::string ScanContextConfig::validate() const {
 
 namespace {
 
-// The descriptor of the points p - origin (origin: the sensor's real or virtual x-y position [m]).
-ScanContext describe(const lidar::PointCloud& cloud, const ScanContextConfig& config, const Eigen::Vector2f& origin) {
+// The descriptor of the points p - origin (origin: the sensor's real or virtual x-y position [m]), heights + lift.
+ScanContext describe(const lidar::PointCloud& cloud, const ScanContextConfig& config, const Eigen::Vector2f& origin,
+                     double lift_m) {
   ScanContext sc;
   sc.image = Eigen::MatrixXf::Zero(config.rings, config.sectors);
   sc.occupied = Eigen::MatrixXf::Zero(config.rings, config.sectors);
@@ -42,7 +43,7 @@ ScanContext describe(const lidar::PointCloud& cloud, const ScanContextConfig& co
   const float max_r = static_cast<float>(config.max_radius), max_r2 = max_r * max_r;
   const float rings_per_m = static_cast<float>(config.rings) / max_r;
   const float sectors_per_rad = static_cast<float>(config.sectors / kTwoPi), two_pi = static_cast<float>(kTwoPi);
-  const float lift = static_cast<float>(config.sensor_height);
+  const float lift = static_cast<float>(lift_m);
   for (const Eigen::Vector3f& p : cloud) {
     const float x = p.x() - origin.x(), y = p.y() - origin.y();
     const float r2 = x * x + y * y;
@@ -68,9 +69,22 @@ void requireValid(const ScanContextConfig& config) {
 
 }  // namespace
 
+double heightLift(const lidar::PointCloud& cloud, const ScanContextConfig& config) {
+  if (!config.auto_height) return config.sensor_height;
+  std::vector<float> z;
+  for (const Eigen::Vector3f& p : cloud) {
+    const float r2 = p.x() * p.x() + p.y() * p.y();
+    if (r2 > 4.0f && r2 < 400.0f && std::isfinite(p.z())) z.push_back(p.z());
+  }
+  if (z.size() < 20) return config.sensor_height;  // too little to tell: the configured mount
+  const auto k = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 20);
+  std::nth_element(z.begin(), k, z.end());
+  return config.ground_lift - static_cast<double>(*k);
+}
+
 ScanContext makeScanContext(const lidar::PointCloud& cloud, const ScanContextConfig& config) {
   requireValid(config);
-  return describe(cloud, config, Eigen::Vector2f::Zero());
+  return describe(cloud, config, Eigen::Vector2f::Zero(), heightLift(cloud, config));
 }
 
 AugmentedScanContext makeAugmentedScanContext(const lidar::PointCloud& cloud, const ScanContextConfig& config) {
@@ -81,7 +95,8 @@ AugmentedScanContext makeAugmentedScanContext(const lidar::PointCloud& cloud, co
   for (int i = -k; i <= k; ++i)
     for (int j = -k; j <= k; ++j)
       if (i != 0 || j != 0) out.offsets.emplace_back(float(i * config.lateral_step), float(j * config.lateral_step));
-  for (const Eigen::Vector2f& o : out.offsets) out.descriptors.push_back(describe(cloud, config, o));
+  const double lift = heightLift(cloud, config);
+  for (const Eigen::Vector2f& o : out.offsets) out.descriptors.push_back(describe(cloud, config, o, lift));
   return out;
 }
 

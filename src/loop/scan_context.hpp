@@ -29,7 +29,12 @@ struct ScanContextConfig {
   int rings = 20;                // [-] radial bins (the paper's N_r)
   int sectors = 60;              // [-] azimuthal bins (N_s), 6 deg each by default
   double max_radius = 80.0;      // [m] points farther (in x-y) are ignored (L_max)
-  double sensor_height = 2.0;    // [m] added to z so that ground-level heights are about zero (KITTI: ~1.73 m)
+  double sensor_height = 2.0;    // [m] added to z so that ground-level heights are slightly positive (the reference's
+                                 // 2.0 for KITTI's 1.73 m mount: ground-only bins must not be zero or negative)
+  // Instead of sensor_height, estimate the ground per scan: lift = ground_lift - (5th percentile of z of the points
+  // 2-20 m away in x-y). For datasets whose platforms differ (one config for a 0.7 m crawler and a 1.8 m car).
+  bool auto_height = false;
+  double ground_lift = 0.3;      // [m] height given to the estimated ground with auto_height
   double threshold = 0.13;       // [-] distance below which two scans are the same place (reference value)
   int search_radius = 3;         // [sectors] dh of the prior-narrowed search
   double lateral_step = 2.0;     // [m] spacing of the virtual sensor positions of the lateral augmentation
@@ -46,6 +51,8 @@ struct ScanContext {
 
 // Descriptor of a cloud in the lidar frame. Non-finite points and points beyond max_radius are ignored. Throws
 // std::invalid_argument when config.validate() fails.
+// The height added to z: sensor_height, or with auto_height the estimate described in the config.
+double heightLift(const lidar::PointCloud& cloud_lidar, const ScanContextConfig& config);
 ScanContext makeScanContext(const lidar::PointCloud& cloud_lidar, const ScanContextConfig& config);
 
 // Mean over the columns non-empty in both of (1 - cosine similarity) between column j of A and column (j - shift)

@@ -155,6 +155,22 @@ TEST(ScanContext, LateralAugmentationFindsTheVirtualPositionOfTheOtherSensor) {
   EXPECT_LT(t.match.distance, 1e-4);
 }
 
+TEST(ScanContext, AutoHeightLiftsTheEstimatedGroundToTheConfiguredHeightWhateverTheMount) {
+  ScanContextConfig cfg;
+  cfg.auto_height = true;
+  cfg.ground_lift = 0.3;
+  for (float mount : {0.7f, 1.8f}) {
+    lidar::PointCloud c = scene();  // poles from z = -2 up
+    for (float x = -19; x <= 19; x += 0.5f)
+      for (float y = -19; y <= 19; y += 0.5f) c.emplace_back(x, y, -mount);
+    EXPECT_NEAR(heightLift(c, cfg), 0.3 + mount, 1e-6);
+  }
+  cfg.auto_height = false;
+  EXPECT_EQ(heightLift(scene(), cfg), cfg.sensor_height);
+  cfg.auto_height = true;
+  EXPECT_EQ(heightLift(lidar::PointCloud{}, cfg), cfg.sensor_height);  // nothing to estimate from
+}
+
 lidar::PointCloud kittiCloud(const std::filesystem::path& bin) {
   lidar::PointCloud c;
   for (const LidarPoint& p : io::readKittiBin(bin.string(), 0, 0).points) c.emplace_back(p.x, p.y, p.z);

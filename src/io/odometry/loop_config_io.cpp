@@ -25,6 +25,8 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
                     .bind("sectors", d.sectors)
                     .bind("max_radius", d.max_radius)
                     .bind("sensor_height", d.sensor_height)
+                    .bind("auto_height", d.auto_height)
+                    .bind("ground_lift", d.ground_lift)
                     .bind("threshold", d.threshold)
                     .bind("search_radius", d.search_radius)
                     .bind("lateral_step", d.lateral_step)

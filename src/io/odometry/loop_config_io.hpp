@@ -4,7 +4,8 @@
 //   loop: enabled, source (scancontext | radius | both), yaw_prior, min_age [s], submap_keyframes,
 //         max_verifications, skip_after_loop, radius [m], odometry_sigma_position [m], odometry_sigma_rotation [rad],
 //         degenerate_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m]
-//     scan_context: rings, sectors, max_radius [m], sensor_height [m], threshold, search_radius [sectors],
+//     scan_context: rings, sectors, max_radius [m], sensor_height [m], auto_height, ground_lift [m], threshold,
+//                   search_radius [sectors],
 //                   lateral_step [m], lateral_steps, candidates, exclude_recent [keyframes]
 //     verifier:     max_fitness [m], min_inliers, min_inlier_ratio, max_correction_translation [m],
 //                   max_correction_rotation [rad], sigma_floor_position [m], sigma_floor_rotation [rad]
