@@ -51,6 +51,12 @@ Json resultJson(const LoopEvalOptions& o, const LoopEvalData& d, const loop::PrC
         d.narrowed_checked > 0 ? Json(static_cast<double>(d.narrowed_equal) / static_cast<double>(d.narrowed_checked))
                                : Json(nullptr);
   }
+  j["false_positives"] = Json::array();
+  for (const LoopEvalData::Detection& f : d.false_positives)
+    j["false_positives"].push_back(Json{{"t_query", toSeconds(f.t_query)},
+                                        {"t_candidate", toSeconds(f.t_candidate)},
+                                        {"distance", f.distance},
+                                        {"true_distance_m", f.true_distance}});
   j["descriptor_ms"] = d.descriptor_ms;
   j["query_ms"] = d.query_ms;
   return j;

@@ -31,6 +31,12 @@ struct LoopEvalData {
   // yaw, +-search_radius) was computed, and how many of those equal the full search's shift.
   std::size_t narrowed_checked = 0, narrowed_equal = 0;
   double descriptor_ms = 0, query_ms = 0;  // [ms] mean per keyframe / per query (mode B: per pair, no query)
+  struct Detection {
+    Time t_query = 0, t_candidate = 0;  // [ns]
+    double distance = 0;                // [-] Scan Context
+    double true_distance = 0;           // [m] between the two by the ground truth
+  };
+  std::vector<Detection> false_positives;  // mode A: detections at the threshold of the wrong place
 };
 
 // The platform config (without --config: the KITTI HDL-64E as config/kitti.yaml describes it), with the

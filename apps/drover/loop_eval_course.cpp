@@ -84,6 +84,7 @@ class CourseEvaluator {
     data_.query_ms += msSince(t0);
     score(index, query, q);
     database_.add(static_cast<int>(index), query.descriptors[0]);
+    if ((index + 1) % 500 == 0) spdlog::info("{} keyframes at {:.1f} s", index + 1, toSeconds(t));
   }
 
   LoopEvalData finish() {
@@ -108,7 +109,12 @@ class CourseEvaluator {
     loop::PlaceQuery pq{best != nullptr, best ? best->match.match.distance : 1.0, m.candidate_correct,
                         m.has_true_revisit};
     data_.queries.push_back(pq);
-    if (!pq.has_candidate || !pq.candidate_correct || pq.distance >= sc_.threshold) return;
+    if (!pq.has_candidate || pq.distance >= sc_.threshold) return;
+    if (!pq.candidate_correct) {
+      data_.false_positives.push_back(
+          {times_[index], times_[static_cast<std::size_t>(best->id)], pq.distance, m.candidate_distance});
+      return;
+    }
     // A detected right place: would the prior-narrowed search (ground-truth relative yaw) find the same shift?
     const std::size_t id = static_cast<std::size_t>(best->id);
     const double yaw = yawOf(poses_[id].linear().transpose() * poses_[index].linear());
