@@ -33,6 +33,18 @@ std::string ScanContextConfig::validate() const {
 
 namespace {
 
+void fillUnitColumns(ScanContext& sc) {
+  sc.column_norms = sc.image.colwise().norm().transpose();
+  sc.unit_columns = sc.image;
+  for (Eigen::Index j = 0; j < sc.image.cols(); ++j)
+    if (sc.column_norms(j) > 0) sc.unit_columns.col(j) /= sc.column_norms(j);
+}
+
+bool hasUnitColumns(const ScanContext& sc) {
+  return sc.unit_columns.rows() == sc.image.rows() && sc.unit_columns.cols() == sc.image.cols() &&
+         sc.column_norms.size() == sc.image.cols();
+}
+
 // The descriptor of the points p - origin (origin: the sensor's real or virtual x-y position [m]), heights + lift.
 ScanContext describe(const lidar::PointCloud& cloud, const ScanContextConfig& config, const Eigen::Vector2f& origin,
                      double lift_m) {
@@ -60,6 +72,7 @@ ScanContext describe(const lidar::PointCloud& cloud, const ScanContextConfig& co
   }
   sc.ring_key = sc.image.rowwise().mean();
   sc.sector_key = sc.image.colwise().mean().transpose();
+  fillUnitColumns(sc);
   return sc;
 }
 
@@ -100,16 +113,21 @@ AugmentedScanContext makeAugmentedScanContext(const lidar::PointCloud& cloud, co
   return out;
 }
 
-double columnDistance(const ScanContext& a, const ScanContext& b, int shift) {
-  requireSameShape(a, b);
-  const int sectors = static_cast<int>(a.image.cols());
+double columnDistance(const ScanContext& a_in, const ScanContext& b_in, int shift) {
+  requireSameShape(a_in, b_in);
+  // Hand-made descriptors may lack the unit columns: complete a copy (makeScanContext's never need it).
+  ScanContext a_own, b_own;
+  const ScanContext* a = &a_in;
+  const ScanContext* b = &b_in;
+  if (!hasUnitColumns(a_in)) a_own = a_in, fillUnitColumns(a_own), a = &a_own;
+  if (!hasUnitColumns(b_in)) b_own = b_in, fillUnitColumns(b_own), b = &b_own;
+  const int sectors = static_cast<int>(a->image.cols());
   double sum = 0;
   int count = 0;
   for (int j = 0; j < sectors; ++j) {
     const int k = wrapShift(j - shift, sectors);
-    const double na = a.image.col(j).norm(), nb = b.image.col(k).norm();
-    if (na == 0 || nb == 0) continue;
-    sum += 1.0 - a.image.col(j).dot(b.image.col(k)) / (na * nb);
+    if (a->column_norms(j) == 0 || b->column_norms(k) == 0) continue;
+    sum += 1.0 - static_cast<double>(a->unit_columns.col(j).dot(b->unit_columns.col(k)));
     ++count;
   }
   return count == 0 ? 1.0 : sum / count;

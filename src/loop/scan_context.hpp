@@ -47,6 +47,10 @@ struct ScanContext {
   Eigen::MatrixXf occupied;   // rings x sectors, 1 where a point fell, else 0
   Eigen::VectorXf ring_key;   // rings: mean of each ring's row (rotation invariant)
   Eigen::VectorXf sector_key; // sectors: mean of each sector's column
+  // Each column of `image` divided by its norm (zero columns stay zero) and the norms, so that a shift's distance
+  // is a sum of dot products; filled by makeScanContext. columnDistance computes them when absent.
+  Eigen::MatrixXf unit_columns;
+  Eigen::VectorXf column_norms;
 };
 
 // Descriptor of a cloud in the lidar frame. Non-finite points and points beyond max_radius are ignored. Throws
