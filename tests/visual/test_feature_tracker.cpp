@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <thread>
 
+#include "io/dataset.hpp"
 #include "support/shared_data.hpp"
 #include "visual/gftt_detector.hpp"
 #include "visual/synthetic_frames.hpp"
@@ -256,6 +258,45 @@ TEST(FeatureTracker, RejectsBadConfigImagesAndTimes) {
   const cv::Mat image = testing::view(testing::texture(640, 480, 1), {0, 0}, kSize, {0, 0});
   tracker.track(10, image);
   EXPECT_THROW(tracker.track(10, image), std::invalid_argument);
+}
+
+// 95 real frames of EuRoC V1_01 (752x480, 20 Hz, rad-tan lens) through the reader: tracks live for many frames,
+// RANSAC keeps most of them, the budget stays nearly full.
+TEST(FeatureTracker, OnEurocFramesTracksAreLongAndMostlyInliers) {
+  const auto path = test::sharedData("euroc/V1_01_easy_micro");
+  DROVER_REQUIRE_SHARED(path / "mav0/cam0/data");
+  io::DatasetOptions options;
+  options.load_imu = false;
+  options.load_lidar = false;
+  const auto reader = io::openDataset(path.string(), "euroc", options);
+  FeatureTracker tracker(CameraModel(reader->calibration().camera), std::make_shared<GfttDetector>(30),
+                         FeatureTrackerConfig{});
+  std::vector<int> finished;
+  double inlier_sum = 0, features_sum = 0;
+  int frames = 0, ransac_frames = 0;
+  while (auto m = reader->next()) {
+    const auto* frame = std::get_if<CameraFrame>(&*m);
+    if (!frame) continue;
+    const TrackingResult r = tracker.track(frame->t, imageView(frame->image));
+    finished.insert(finished.end(), r.finished_lengths.begin(), r.finished_lengths.end());
+    features_sum += static_cast<double>(r.features.size());
+    if (r.ransac_run) {
+      inlier_sum += r.inlier_ratio;
+      ++ransac_frames;
+    }
+    ++frames;
+  }
+  ASSERT_GE(frames, 90);
+  ASSERT_GT(finished.size(), 20u);
+  double mean_length = 0;
+  for (int l : finished) mean_length += l;
+  mean_length /= static_cast<double>(finished.size());
+  EXPECT_GT(mean_length, 6.0);
+  EXPECT_LT(mean_length, 95.0);
+  EXPECT_GT(inlier_sum / ransac_frames, 0.85);
+  EXPECT_GT(features_sum / frames, 120.0);
+  std::printf("EuRoC: %d frames, %.1f features/frame, mean finished track length %.1f, inlier ratio %.3f\n", frames,
+              features_sum / frames, mean_length, inlier_sum / ransac_frames);
 }
 
 }  // namespace
