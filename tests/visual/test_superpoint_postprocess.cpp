@@ -1,0 +1,148 @@
+// SuperPoint post-processing alone on hand-made network outputs, where the answer is known exactly.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "visual/superpoint_postprocess.hpp"
+
+namespace drover::visual {
+namespace {
+
+constexpr int kHc = 6, kWc = 8;  // a 64 x 48 network image
+
+// Logits where every cell is certainly empty: dustbin 0, keypoint channels -30 (probability ~1e-13).
+cv::Mat emptySemi() {
+  const int shape[4] = {1, 65, kHc, kWc};
+  cv::Mat semi(4, shape, CV_32F, cv::Scalar(-30));
+  for (int y = 0; y < kHc; ++y)
+    for (int x = 0; x < kWc; ++x) semi.at<float>(cv::Vec4i(0, 64, y, x)) = 0;
+  return semi;
+}
+
+// Gives pixel (x, y) the probability p (the cell's dustbin takes the rest, other pixels stay ~0).
+void setProbability(cv::Mat& semi, int x, int y, double p) {
+  const int cx = x / 8, cy = y / 8, c = (y % 8) * 8 + x % 8;
+  semi.at<float>(cv::Vec4i(0, c, cy, cx)) = 0;
+  semi.at<float>(cv::Vec4i(0, 64, cy, cx)) = static_cast<float>(std::log((1 - p) / p));
+}
+
+Keypoints run(const cv::Mat& semi, const cv::Mat& mask = cv::Mat(), SuperPointPostConfig cfg = {}) {
+  SuperPointPostprocessor post(cfg);
+  return post.run(semi, cv::Mat(), mask, 1000);
+}
+
+TEST(SuperPointPostprocess, ASinglePeakIsOneKeypointAtItsPixelWithItsProbability) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 21, 13, 0.8);  // cell (2, 1), channel 5*8 + 5
+  const Keypoints k = run(semi);
+  ASSERT_EQ(k.points.size(), 1u);
+  EXPECT_EQ(k.points[0], cv::Point2f(21, 13));
+  EXPECT_NEAR(k.scores[0], 0.8, 1e-6);
+  EXPECT_TRUE(k.descriptors.empty());
+}
+
+TEST(SuperPointPostprocess, OfTwoPeaksWithinTheNmsRadiusOnlyTheStrongerSurvives) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 20, 20, 0.5);
+  setProbability(semi, 24, 23, 0.7);  // Chebyshev distance 4 = radius: suppressed neighbour
+  Keypoints k = run(semi);
+  ASSERT_EQ(k.points.size(), 1u);
+  EXPECT_EQ(k.points[0], cv::Point2f(24, 23));
+  setProbability(semi, 20, 20, 0.9);  // now the other one is stronger
+  k = run(semi);
+  ASSERT_EQ(k.points.size(), 1u);
+  EXPECT_EQ(k.points[0], cv::Point2f(20, 20));
+}
+
+TEST(SuperPointPostprocess, PeaksFartherThanTheNmsRadiusBothSurviveStrongestFirst) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 20, 20, 0.5);
+  setProbability(semi, 25, 20, 0.7);  // distance 5 > 4
+  const Keypoints k = run(semi);
+  ASSERT_EQ(k.points.size(), 2u);
+  EXPECT_EQ(k.points[0], cv::Point2f(25, 20));
+  EXPECT_EQ(k.points[1], cv::Point2f(20, 20));
+  EXPECT_GT(k.scores[0], k.scores[1]);
+}
+
+TEST(SuperPointPostprocess, PointsWithinTheBorderAreRemovedButStillSuppressNeighbours) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 3, 20, 0.9);   // x < 4: border
+  setProbability(semi, 6, 20, 0.5);   // within the border point's NMS window
+  setProbability(semi, 4, 40, 0.6);   // x = 4: first column kept
+  setProbability(semi, 60, 43, 0.5);  // x = W-4, y = H-5: x out, y in
+  setProbability(semi, 59, 10, 0.5);  // x = W-5: kept
+  const Keypoints k = run(semi);
+  ASSERT_EQ(k.points.size(), 2u);
+  EXPECT_EQ(k.points[0], cv::Point2f(4, 40));
+  EXPECT_EQ(k.points[1], cv::Point2f(59, 10));
+}
+
+TEST(SuperPointPostprocess, ProbabilitiesBelowTheThresholdAreNotKeypoints) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 20, 20, 0.014);
+  setProbability(semi, 40, 20, 0.016);
+  Keypoints k = run(semi);
+  ASSERT_EQ(k.points.size(), 1u);
+  EXPECT_EQ(k.points[0], cv::Point2f(40, 20));
+  SuperPointPostConfig strict;
+  strict.confidence_threshold = 0.5;
+  EXPECT_TRUE(run(semi, cv::Mat(), strict).points.empty());
+}
+
+TEST(SuperPointPostprocess, MaskedCandidatesAreDroppedBeforeNms) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 20, 20, 0.9);
+  setProbability(semi, 23, 20, 0.5);
+  cv::Mat mask(48, 64, CV_8UC1, cv::Scalar(255));
+  mask.at<uchar>(20, 20) = 0;  // the strong one is under a live track
+  const Keypoints k = run(semi, mask);
+  ASSERT_EQ(k.points.size(), 1u);
+  EXPECT_EQ(k.points[0], cv::Point2f(23, 20));
+}
+
+TEST(SuperPointPostprocess, MaxCountKeepsTheStrongest) {
+  cv::Mat semi = emptySemi();
+  for (int i = 0; i < 5; ++i) setProbability(semi, 10 + 10 * i, 24, 0.2 + 0.1 * i);
+  SuperPointPostprocessor post;
+  const Keypoints k = post.run(semi, cv::Mat(), cv::Mat(), 2);
+  ASSERT_EQ(k.points.size(), 2u);
+  EXPECT_EQ(k.points[0], cv::Point2f(50, 24));
+  EXPECT_EQ(k.points[1], cv::Point2f(40, 24));
+  EXPECT_TRUE(post.run(semi, cv::Mat(), cv::Mat(), 0).points.empty());
+}
+
+TEST(SuperPointPostprocess, DescriptorsAreBilinearBetweenCellCentresAndUnitLength) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 12, 11, 0.9);  // u = (12 - 3.5) / 8 = 1.0625, v = (11 - 3.5) / 8 = 0.9375
+  const int shape[4] = {1, 256, kHc, kWc};
+  cv::Mat desc(4, shape, CV_32F, cv::Scalar(0));
+  // Cells (u, v): (1, 0) -> 2 e0 (normalised to e0), (2, 0) -> e1, (1, 1) -> 3 e2, (2, 1) -> e3.
+  desc.at<float>(cv::Vec4i(0, 0, 0, 1)) = 2;
+  desc.at<float>(cv::Vec4i(0, 1, 0, 2)) = 1;
+  desc.at<float>(cv::Vec4i(0, 2, 1, 1)) = 3;
+  desc.at<float>(cv::Vec4i(0, 3, 1, 2)) = 1;
+  SuperPointPostprocessor post;
+  const Keypoints k = post.run(semi, desc, cv::Mat(), 10);
+  ASSERT_EQ(k.descriptors.rows, 1);
+  const double fu = 0.0625, fv = 0.9375;
+  const double w[4] = {(1 - fu) * (1 - fv), fu * (1 - fv), (1 - fu) * fv, fu * fv};
+  const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2] + w[3] * w[3]);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(k.descriptors.at<float>(0, c), w[c] / norm, 1e-6) << c;
+  EXPECT_NEAR(cv::norm(k.descriptors.row(0)), 1.0, 1e-6);
+}
+
+TEST(SuperPointPostprocess, OutputsOfTheWrongShapeAreRejected) {
+  SuperPointPostprocessor post;
+  const int bad_shape[4] = {1, 64, kHc, kWc};
+  EXPECT_THROW(post.run(cv::Mat(4, bad_shape, CV_32F, cv::Scalar(0)), cv::Mat(), cv::Mat(), 10),
+               std::invalid_argument);
+  const int desc_shape[4] = {1, 256, kHc, kWc + 1};
+  EXPECT_THROW(post.run(emptySemi(), cv::Mat(4, desc_shape, CV_32F, cv::Scalar(0)), cv::Mat(), 10),
+               std::invalid_argument);
+  EXPECT_THROW(post.run(emptySemi(), cv::Mat(), cv::Mat(47, 64, CV_8UC1), 10), std::invalid_argument);
+  EXPECT_THROW(post.run(emptySemi(), cv::Mat(), cv::Mat(), -1), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace drover::visual
