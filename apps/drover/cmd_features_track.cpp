@@ -32,7 +32,8 @@ struct TrackOptions {
 };
 
 Json frameJson(const visual::TrackingResult& r, Time t0) {
-  return Json{{"t", static_cast<double>(r.t - t0) * 1e-9},
+  return Json{{"t", static_cast<double>(r.t - t0) * 1e-9},  // [s] since the first camera frame
+              {"stamp_ns", r.t},                            // the dataset's stamp
               {"features", r.features.size()},
               {"new", r.added},
               {"tracked", r.tracked},
