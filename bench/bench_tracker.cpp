@@ -35,8 +35,8 @@ const Frames& frames() {
     out.intrinsics = config.camera.intrinsics;
     for (int k = 0; k < 60; ++k) {
       const Time t = 3'000'000'000 + k * 1'000'000'000LL / 15;
-      const auto frame = renderer.render(scenario.world, *scenario.trajectory, config.T_imu_cam,
-                                         scenario.illumination, t, 1, static_cast<std::uint64_t>(k));
+      const auto frame = renderer.render(scenario.world, *scenario.trajectory, config.T_imu_cam, scenario.illumination,
+                                         t, 1, static_cast<std::uint64_t>(k));
       out.images.push_back(visual::imageView(frame.image).clone());
       out.times.push_back(t);
     }
@@ -111,10 +111,15 @@ void BM_DetectAndTrack640x480(benchmark::State& state, visual::DetectorType type
   trackFrames(state, [&] { return std::shared_ptr<visual::KeypointDetector>(visual::makeDetector(config)); });
 }
 BENCHMARK_CAPTURE(BM_DetectAndTrack640x480, shi_tomasi, visual::DetectorType::kShiTomasi)
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_DetectAndTrack640x480, orb, visual::DetectorType::kOrb)->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_DetectAndTrack640x480, orb, visual::DetectorType::kOrb)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK_CAPTURE(BM_DetectAndTrack640x480, superpoint, visual::DetectorType::kSuperPoint)
-    ->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(60);
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(60);
 
 }  // namespace
 

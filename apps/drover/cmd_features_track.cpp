@@ -61,10 +61,12 @@ Json summaryJson(const visual::TrackingSummary& s) {
 }
 
 void check(const TrackOptions& o) {
-  if (!std::isfinite(o.start) || o.start < 0) throw std::invalid_argument(fmt::format("--start must be >= 0 s, got {}", o.start));
+  if (!std::isfinite(o.start) || o.start < 0)
+    throw std::invalid_argument(fmt::format("--start must be >= 0 s, got {}", o.start));
   if (!std::isfinite(o.duration) || o.duration < 0)
     throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
-  if (o.overlay_every < 0) throw std::invalid_argument(fmt::format("--overlay-every must be >= 0, got {}", o.overlay_every));
+  if (o.overlay_every < 0)
+    throw std::invalid_argument(fmt::format("--overlay-every must be >= 0, got {}", o.overlay_every));
   if (o.max_frames < 0) throw std::invalid_argument(fmt::format("--max-frames must be >= 0, got {}", o.max_frames));
 }
 
@@ -107,14 +109,15 @@ void runTrack(const TrackOptions& o) {
   }
   if (index == 0) throw std::runtime_error(o.dataset + ": no camera frames (in the --start/--duration window)");
   const visual::TrackingSummary s = summary.summary();
-  const Json j{{"dataset", o.dataset}, {"format", o.format}, {"detector", o.detector}, {"async", o.async},
-               {"summary", summaryJson(s)}, {"frames", frames}};
+  const Json j{{"dataset", o.dataset}, {"format", o.format},        {"detector", o.detector},
+               {"async", o.async},     {"summary", summaryJson(s)}, {"frames", frames}};
   io::writeFileAtomically((std::filesystem::path(o.out) / "tracks.json").string(), j.dump(1) + "\n");
   if (!o.quiet)
-    fmt::print("{} frames, {:.1f} features/frame, mean track length {:.1f} frames ({} finished tracks), RANSAC "
-               "inliers {:.3f}, {:.2f} ms/frame (p95 {:.2f}), {:.1f} % of frames with >= 50 tracked\n",
-               s.frames, s.mean_features, s.mean_track_length, s.finished_tracks, s.mean_inlier_ratio, s.mean_ms,
-               s.p95_ms, 100 * s.fraction_tracked_ge_50);
+    fmt::print(
+        "{} frames, {:.1f} features/frame, mean track length {:.1f} frames ({} finished tracks), RANSAC "
+        "inliers {:.3f}, {:.2f} ms/frame (p95 {:.2f}), {:.1f} % of frames with >= 50 tracked\n",
+        s.frames, s.mean_features, s.mean_track_length, s.finished_tracks, s.mean_inlier_ratio, s.mean_ms, s.p95_ms,
+        100 * s.fraction_tracked_ge_50);
 }
 
 }  // namespace

@@ -48,7 +48,8 @@ std::string validateIntrinsics(const CameraIntrinsics& k) {
       if (n != 4) return "equidistant needs 4 coefficients, got " + std::to_string(n);
       break;
     case DistortionModel::kNone:
-      if (n != 0 && std::any_of(k.distortion_coeffs.begin(), k.distortion_coeffs.end(), [](double c) { return c != 0; }))
+      if (n != 0 &&
+          std::any_of(k.distortion_coeffs.begin(), k.distortion_coeffs.end(), [](double c) { return c != 0; }))
         return "distortion model none with non-zero coefficients";
       break;
   }
@@ -73,7 +74,8 @@ CameraModel::CameraModel(const CameraIntrinsics& intrinsics) : intrinsics_(intri
     const double s = i / 64.0;
     for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(s * w - 0.5, -0.5), Eigen::Vector2d(s * w - 0.5, h - 0.5),
                                          Eigen::Vector2d(-0.5, s * h - 0.5), Eigen::Vector2d(w - 0.5, s * h - 0.5)}) {
-      const Eigen::Vector2d xd((pixel.x() - intrinsics.cx) / intrinsics.fx, (pixel.y() - intrinsics.cy) / intrinsics.fy);
+      const Eigen::Vector2d xd((pixel.x() - intrinsics.cx) / intrinsics.fx,
+                               (pixel.y() - intrinsics.cy) / intrinsics.fy);
       const auto xn = undistortNormalized(intrinsics, xd, tolerance_);
       if (!xn) return;  // not invertible at the border: leave the radius unlimited
       border_r2 = std::max(border_r2, xn->squaredNorm());

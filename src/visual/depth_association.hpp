@@ -1,16 +1,16 @@
 #pragma once
-// Lidar depth for visual features, LVI-SAM's method (Shan et al., "LVI-SAM", ICRA 2021, Sec. III-B.2 and Fig. 3;
-// visual_feature/feature_tracker_node's depth registration): keep the deskewed sweeps of a recent time window in
-// the world frame (voxel-downsampled), move them into the current camera frame, keep the nearest point per cell of
-// a spherical (azimuth x elevation) grid, put those on the unit sphere, and for each feature ray take the three
-// nearest lidar points on the sphere and intersect the ray with their plane. (Departure: when the third nearest is
-// collinear with the first two, as often on one scan line, the next non-collinear neighbour among the 8 nearest
-// within the angular limit replaces it; LVI-SAM would take the ill-conditioned plane.) The depth is rejected when the three
+// Lidar depth for visual features, LVI-SAM's method (Shan et al., "LVI-SAM", ICRA 2021, Sec. III-B.2, Fig. 3;
+// visual_feature/feature_tracker_node's depth registration): keep the deskewed sweeps of a recent time window in the
+// world frame (voxel-downsampled), move them into the current camera frame, keep the nearest point per cell of a
+// spherical (azimuth x elevation) grid, put those on the unit sphere, and for each feature ray take the three nearest
+// lidar points on the sphere and intersect the ray with their plane. (Departure: when the third nearest is collinear
+// with the first two, as often on one scan line, the next non-collinear neighbour among the 8 nearest within the
+// angular limit replaces it; LVI-SAM would take the ill-conditioned plane.) The depth is rejected when the three
 // points' ranges spread more than `max_depth_spread` (a depth discontinuity: the plane would bridge foreground and
-// background), when they are not all close to the ray on the sphere, when the ray grazes their plane, or when the
-// depth falls outside [min_depth, max_depth]. LVI-SAM clamps the intersection to the three ranges; that is wrong
-// on a plane seen head-on (the ray's range is below all three), so here the intersection is kept as it is and
-// rejected (as grazing) only when it lies more than max_depth_spread outside the three ranges.
+// background), when they are not all close to the ray on the sphere, when the ray grazes their plane, or when the depth
+// falls outside [min_depth, max_depth]. LVI-SAM clamps the intersection to the three ranges; that is wrong on a plane
+// seen head-on (the ray's range is below all three), so here the intersection is kept as it is and rejected (as
+// grazing) only when it lies more than max_depth_spread outside the three ranges.
 //
 // Frames: points in the world frame [m]; the camera pose is T_world_cam (z forward, x right, y down). The depth
 // returned is along the optical axis (z), so the feature's point is depth * (x_n, y_n, 1).

@@ -1,6 +1,8 @@
 // KLT tracking step of the feature tracker: preprocessing, flow with forward-backward and border checks, and the
 // fundamental-matrix RANSAC (VINS-Mono feature_tracker.cpp: readImage, rejectWithF). Replenishment is in
 // feature_tracker_detect.cpp.
+#include "visual/feature_tracker.hpp"
+
 #include <chrono>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -8,14 +10,13 @@
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 
-#include "visual/feature_tracker.hpp"
-
 namespace drover::visual {
 
 std::string FeatureTrackerConfig::validate() const {
   if (max_features < 1) return "max_features must be >= 1, got " + std::to_string(max_features);
   if (!(min_distance >= 0)) return "min_distance must be >= 0 px, got " + std::to_string(min_distance);
-  if (flow_window < 3 || flow_window % 2 == 0) return "flow_window must be odd and >= 3, got " + std::to_string(flow_window);
+  if (flow_window < 3 || flow_window % 2 == 0)
+    return "flow_window must be odd and >= 3, got " + std::to_string(flow_window);
   if (flow_levels < 0 || flow_levels > 8) return "flow_levels must be in [0, 8], got " + std::to_string(flow_levels);
   if (flow_iterations < 1) return "flow_iterations must be >= 1, got " + std::to_string(flow_iterations);
   if (!(flow_epsilon > 0)) return "flow_epsilon must be > 0, got " + std::to_string(flow_epsilon);
@@ -164,8 +165,8 @@ void FeatureTracker::rejectWithFundamental(const std::vector<Eigen::Vector2d>& p
                    static_cast<float>(f * tracks_.normalized[i].y() + cy));
   }
   std::vector<unsigned char> inlier;
-  const cv::Mat F = cv::findFundamentalMat(a, b, cv::FM_RANSAC, config_.ransac_threshold_px,
-                                           config_.ransac_confidence, inlier);
+  const cv::Mat F =
+      cv::findFundamentalMat(a, b, cv::FM_RANSAC, config_.ransac_threshold_px, config_.ransac_confidence, inlier);
   result.ransac_run = true;
   if (F.empty() || inlier.size() != tracks_.size()) {  // degenerate (e.g. no motion): keep everything
     result.inlier_ratio = 1.0;
@@ -193,8 +194,8 @@ TrackingResult FeatureTracker::track(Time t, const cv::Mat& image) {
   has_previous_ = true;
   result.features.reserve(tracks_.size());
   for (std::size_t i = 0; i < tracks_.size(); ++i)
-    result.features.push_back({tracks_.ids[i], tracks_.lengths[i], tracks_.pixels[i], tracks_.normalized[i],
-                               tracks_.velocity[i]});
+    result.features.push_back(
+        {tracks_.ids[i], tracks_.lengths[i], tracks_.pixels[i], tracks_.normalized[i], tracks_.velocity[i]});
   result.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

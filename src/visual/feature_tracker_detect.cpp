@@ -66,8 +66,8 @@ int detectionCount(int wanted) { return wanted > 0 ? 2 * wanted + 20 : 0; }
 
 // Carries points detected in `first` through `frames` (with the forward-backward check when configured); lost
 // points become NaN.
-std::vector<cv::Point2f> carry(std::vector<cv::Point2f> points, const cv::Mat& first, const std::vector<cv::Mat>& frames,
-                               const FeatureTrackerConfig& config) {
+std::vector<cv::Point2f> carry(std::vector<cv::Point2f> points, const cv::Mat& first,
+                               const std::vector<cv::Mat>& frames, const FeatureTrackerConfig& config) {
   const cv::Size window(config.flow_window, config.flow_window);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   cv::Mat previous = first;
@@ -119,7 +119,8 @@ void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
     frames_since_job_.clear();
     const int wanted = detectionCount(config_.max_features - static_cast<int>(tracks_.size()));
     KeypointDetector* detector = detector_.get();
-    job_ = std::async(std::launch::async, [detector, gray, mask = mask.clone(), wanted] { return detector->detect(gray, mask, wanted); });
+    job_ = std::async(std::launch::async,
+                      [detector, gray, mask = mask.clone(), wanted] { return detector->detect(gray, mask, wanted); });
   }
 }
 

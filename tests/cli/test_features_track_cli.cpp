@@ -24,8 +24,8 @@ TEST(FeaturesTrackCli, WritesPerFrameRecordsSummaryAndOverlays) {
   EXPECT_TRUE(contains(r.output, "60 frames")) << r.output;
   const auto j = readJson(dir.path() / "tracks.json");
   ASSERT_EQ(j["frames"].size(), 60u);
-  for (const char* key : {"t", "features", "new", "tracked", "rejected_fb", "rejected_border", "rejected_ransac",
-                          "inlier_ratio", "ms"})
+  for (const char* key :
+       {"t", "features", "new", "tracked", "rejected_fb", "rejected_border", "rejected_ransac", "inlier_ratio", "ms"})
     EXPECT_TRUE(j["frames"][0].contains(key)) << key;
   EXPECT_EQ(j["frames"][0]["tracked"], 0) << "nothing to track on the first frame";
   EXPECT_EQ(j["frames"][0]["features"], j["frames"][0]["new"]);
@@ -68,8 +68,8 @@ TEST(FeaturesTrackCli, AsyncModeRunsAndRecordsIt) {
 
 TEST(FeaturesTrackCli, BadInputIsOneErrorLineAndExitCode2) {
   TempDir dir;
-  CliResult r = runDrover("features track " + (dir.path() / "missing").string() + " --format euroc --detector orb --out " +
-                          (dir.path() / "o").string());
+  CliResult r = runDrover("features track " + (dir.path() / "missing").string() +
+                          " --format euroc --detector orb --out " + (dir.path() / "o").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(contains(r.output, "[error]")) << r.output;
   DROVER_REQUIRE_SHARED(kEuroc);

@@ -1,9 +1,9 @@
 #pragma once
 // A small Shi-Tomasi detector for the visual tests (cv::goodFeaturesToTrack, as VINS-Mono), so that the tracker's
 // tests do not depend on the detector implementations; optionally slow, to exercise asynchronous detection.
-#include <opencv2/imgproc.hpp>
 #include <atomic>
 #include <mutex>
+#include <opencv2/imgproc.hpp>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -14,7 +14,8 @@ namespace drover::visual::testing {
 
 class GfttDetector : public KeypointDetector {
  public:
-  explicit GfttDetector(double min_distance = 30, int delay_ms = 0) : min_distance_(min_distance), delay_ms_(delay_ms) {}
+  explicit GfttDetector(double min_distance = 30, int delay_ms = 0)
+      : min_distance_(min_distance), delay_ms_(delay_ms) {}
   Keypoints detect(const cv::Mat& image, const cv::Mat& mask, int max_count) override {
     ++calls;
     if (delay_ms_ > 0) std::this_thread::sleep_for(std::chrono::milliseconds(delay_ms_));

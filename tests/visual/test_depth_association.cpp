@@ -1,6 +1,4 @@
 // Lidar depth for features: exact planes, discontinuities, windows, and the simulator's ground truth.
-#include "visual/depth_association.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,6 +11,7 @@
 #include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
 #include "visual/camera_model.hpp"
+#include "visual/depth_association.hpp"
 #include "visual/feature_tracker.hpp"
 
 namespace drover::visual {
@@ -111,7 +110,8 @@ TEST(DepthAssociation, UsesOnlySweepsInsideTheWindowAndTheDepthRange) {
   EXPECT_EQ(associator.associate(kSecond / 2, Eigen::Isometry3d::Identity(), features).associated, 20);
   EXPECT_EQ(associator.associate(2 * kSecond, Eigen::Isometry3d::Identity(), features).associated, 0)
       << "the sweep is older than the window";
-  associator.addSweep(3 * kSecond, planePoints({0, 0, 0.3}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1, 0.01));
+  associator.addSweep(3 * kSecond,
+                      planePoints({0, 0, 0.3}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 1, 0.01));
   EXPECT_EQ(associator.sweepCount(), 1u);
   const DepthAssociationResult r = associator.associate(3 * kSecond, Eigen::Isometry3d::Identity(), features);
   EXPECT_EQ(r.rejected_range, 20) << "0.3 m is below min_depth";
@@ -145,8 +145,8 @@ TEST(DepthAssociation, OnTheSimulatorCourseMedianRelativeErrorIsBelowTwoPercent)
   Time next_sweep = 0;
   for (Time t_frame = 2 * kSecond; t_frame <= 5 * kSecond; t_frame += kSecond / 2) {
     while (next_sweep + kSecond / 10 <= t_frame) {  // sweeps that ended before the frame
-      const LidarScan scan =
-          sim::simulateSweep(scenario.world, trajectory, config.T_imu_lidar, next_sweep, config.lidar, 7, sweep_index++);
+      const LidarScan scan = sim::simulateSweep(scenario.world, trajectory, config.T_imu_lidar, next_sweep,
+                                                config.lidar, 7, sweep_index++);
       std::vector<Eigen::Vector3d> points_world;
       for (const LidarPoint& p : scan.points) {
         const Time t_point = scan.t + static_cast<Time>(std::llround(p.time_offset * 1e9));
@@ -156,8 +156,8 @@ TEST(DepthAssociation, OnTheSimulatorCourseMedianRelativeErrorIsBelowTwoPercent)
       next_sweep += kSecond / 10;
     }
     const Eigen::Isometry3d T_world_cam = trajectory.pose(t_frame) * config.T_imu_cam;
-    const CameraFrame frame = renderer.render(scenario.world, trajectory, config.T_imu_cam, scenario.illumination,
-                                              t_frame, 1, 0);
+    const CameraFrame frame =
+        renderer.render(scenario.world, trajectory, config.T_imu_cam, scenario.illumination, t_frame, 1, 0);
     std::vector<cv::Point2f> corners;
     cv::goodFeaturesToTrack(imageView(frame.image), corners, 150, 0.01, 20);
     std::vector<Eigen::Vector2d> normalized;

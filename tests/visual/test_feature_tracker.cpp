@@ -1,6 +1,4 @@
 // KLT tracker on synthetic sequences with known motion, and on real EuRoC frames.
-#include "visual/feature_tracker.hpp"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +8,7 @@
 
 #include "io/dataset.hpp"
 #include "support/shared_data.hpp"
+#include "visual/feature_tracker.hpp"
 #include "visual/gftt_detector.hpp"
 #include "visual/synthetic_frames.hpp"
 
@@ -51,7 +50,8 @@ double percentile(std::vector<double> v, double q) {
 }
 
 // Frame-to-frame flow errors on a sub-pixel translation: median within 0.05 px, 95 % within 0.1 px (the rest, on
-// weakly textured windows, within the 0.5 px forward-backward threshold); ids persist and lengths grow by one a frame; velocity = step / f / dt.
+// weakly textured windows, within the 0.5 px forward-backward threshold); ids persist and lengths grow by one a frame;
+// velocity = step / f / dt.
 TEST(FeatureTracker, TracksATranslatedTextureToATenthOfAPixelAndKeepsIds) {
   const auto canvas = testing::texture(1000, 800, 1);
   FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(), baseConfig());
@@ -71,7 +71,9 @@ TEST(FeatureTracker, TracksATranslatedTextureToATenthOfAPixelAndKeepsIds) {
         step_errors.push_back(cv::norm(cv::Point2d(f.pixel - previous[f.id].pixel) - step));
         const Eigen::Vector2d expected_velocity(step.x / 460 / 0.05, step.y / 460 / 0.05);
         velocity_errors.push_back((f.velocity - expected_velocity).norm() * 460 * 0.05);  // [px / frame]
-        if (i == 19) drift.push_back(cv::norm(cv::Point2d(f.pixel) - (cv::Point2d(origin[f.id].pixel) + step * (i - origin[f.id].frame))));
+        if (i == 19)
+          drift.push_back(
+              cv::norm(cv::Point2d(f.pixel) - (cv::Point2d(origin[f.id].pixel) + step * (i - origin[f.id].frame))));
       }
       previous[f.id] = {i, f.pixel};
     }
@@ -109,10 +111,10 @@ TEST(FeatureTracker, ReplenishmentFillsTheMaskButKeepsTheMinimumDistance) {
 
 // A camera translating along x past a 4x4 checkerboard of blocks at different depths (2 to 6 px/frame, all
 // horizontal: one epipolar geometry; the speeds are shuffled so that no single plane, e.g. a tilted ground, explains
-// them, which would leave the fundamental matrix undetermined); eight 80 px patches move on their own, each in another direction with at
-// least 8 px/frame across the epipolar lines (independently moving objects). The RANSAC must drop their tracks.
-// (With frame-to-frame motions of a few pixels a 1 px threshold leaves the epipolar geometry loose, so what RANSAC
-// can catch are gross outliers; smaller independent motions may fit some other F.)
+// them, which would leave the fundamental matrix undetermined); eight 80 px patches move on their own, each in another
+// direction with at least 8 px/frame across the epipolar lines (independently moving objects). The RANSAC must drop
+// their tracks. (With frame-to-frame motions of a few pixels a 1 px threshold leaves the epipolar geometry loose, so
+// what RANSAC can catch are gross outliers; smaller independent motions may fit some other F.)
 TEST(FeatureTracker, FundamentalRansacDropsIndependentlyMovingPoints) {
   const auto background = testing::texture(1200, 800, 3);
   const auto patch_texture = testing::texture(800, 600, 5);
@@ -150,7 +152,9 @@ TEST(FeatureTracker, FundamentalRansacDropsIndependentlyMovingPoints) {
         // 15 px inside: the whole 21 px LK window lay on the patch in both frames (windows straddling its edge
         // mix the two motions and may look consistent)
         EXPECT_FALSE(patchRect(k, i, 15).contains(f.pixel))
-            << "frame " << i << ": a track on moving patch " << k << " survived: id " << f.id << " at " << f.pixel << " moved " << (f.velocity * 0.05 * 460).transpose() << " ratio " << r.inlier_ratio << " rejected " << r.rejected_ransac << " tracked " << r.tracked;
+            << "frame " << i << ": a track on moving patch " << k << " survived: id " << f.id << " at " << f.pixel
+            << " moved " << (f.velocity * 0.05 * 460).transpose() << " ratio " << r.inlier_ratio << " rejected "
+            << r.rejected_ransac << " tracked " << r.tracked;
     }
   }
   EXPECT_GT(rejected, 20);
