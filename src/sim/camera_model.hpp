@@ -20,6 +20,7 @@
 #include "sim/trajectory.hpp"
 #include "sim/world.hpp"
 #include "types/calibration.hpp"
+#include "types/camera_distortion.hpp"
 #include "types/camera.hpp"
 
 namespace drover::sim {
@@ -44,16 +45,9 @@ struct CameraModelConfig {
   std::string validate() const;
 };
 
-// Lens distortion on normalised image coordinates xn = (x / z, y / z) (Brown-Conrady, as OpenCV and Kalibr
-// "radtan"): r2 = |xn|^2, radial = 1 + k1 r2 + k2 r2^2 + k3 r2^3,
-//   xd = x radial + 2 p1 x y + p2 (r2 + 2 x^2),   yd = y radial + p1 (r2 + 2 y^2) + 2 p2 x y.
-// J_xd_xn, when given, receives the Jacobian d xd / d xn. kNone returns xn (J = identity).
-Eigen::Vector2d distortNormalized(const CameraIntrinsics& intrinsics, const Eigen::Vector2d& xn,
-                                  Eigen::Matrix2d* J_xd_xn = nullptr);
-// Inverse of distortNormalized by Newton's method started at xd; nothing when |distort(xn) - xd| does not fall
-// below `tolerance` (normalised units) within 50 iterations.
-std::optional<Eigen::Vector2d> undistortNormalized(const CameraIntrinsics& intrinsics, const Eigen::Vector2d& xd,
-                                                   double tolerance);
+// Lens distortion on normalised image coordinates: the shared maths of types/camera_distortion.hpp.
+using drover::distortNormalized;
+using drover::undistortNormalized;
 
 // The fixed directional light of the renderer (world frame, unit, pointing towards the light): a sun 60 deg above
 // the horizon at azimuth 30 deg from world x towards y, i.e. (cos 60 cos 30, cos 60 sin 30, sin 60). The same

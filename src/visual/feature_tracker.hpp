@@ -1,0 +1,128 @@
+#pragma once
+// KLT feature tracker with VINS-Mono's feature_tracker semantics (Qin et al., "VINS-Mono", T-RO 2018, Sec. IV-A;
+// feature_tracker.cpp): pyramidal Lucas-Kanade flow from the previous frame, a border check, outlier rejection by a
+// fundamental-matrix RANSAC on undistorted points reprojected with a virtual focal length, persistent ids and track
+// lengths, and replenishment by a KeypointDetector inside a mask that keeps `min_distance` around live tracks (long
+// tracks claim their neighbourhood first, as VINS-Mono's setMask). Added here: a forward-backward flow check (as
+// VINS-Fusion's FLOW_BACK), optional CLAHE (always or only on dark frames), and asynchronous detection so that a
+// slow detector (SuperPoint, ~0.3-0.6 s a frame on a laptop CPU) does not hold back the camera rate.
+//
+// Synchronous mode (the default; tests and evaluation): the same frames give the same tracks, bit for bit.
+// Asynchronous mode: the detector runs in one worker thread on frame k with the mask of frame k; when its points
+// are ready (at frame j > k) they are carried by the flow through the frames k+1..j, filtered by the mask of frame
+// j, and added. Results then depend on timing. The first detection (no live tracks) is always synchronous.
+#include <Eigen/Core>
+#include <cstdint>
+#include <future>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "types/camera.hpp"
+#include "visual/camera_model.hpp"
+#include "visual/keypoint_detector.hpp"
+
+namespace drover::visual {
+
+enum class ClaheMode { kOff, kAlways, kWhenDark };
+
+struct FeatureTrackerConfig {
+  int max_features = 150;           // live tracks kept (VINS-Mono max_cnt)
+  double min_distance = 30;         // [px] between features (VINS-Mono min_dist)
+  int flow_window = 21;             // [px] LK window side (VINS-Mono: 21)
+  int flow_levels = 3;              // pyramid levels above the image (cv::calcOpticalFlowPyrLK maxLevel)
+  int flow_iterations = 30;         // LK iterations per level
+  double flow_epsilon = 0.01;       // [px] LK convergence
+  bool forward_backward = true;     // track back and drop points that do not return
+  double forward_backward_px = 0.5;  // [px] largest forward-backward distance kept
+  int border_px = 1;                // [px] points closer to the image edge are dropped (VINS-Mono inBorder)
+  bool ransac = true;               // fundamental-matrix RANSAC (VINS-Mono rejectWithF)
+  double ransac_threshold_px = 1.0;  // [px at the virtual focal length] (VINS-Mono F_threshold)
+  double ransac_confidence = 0.99;
+  double virtual_focal_px = 460;    // [px] focal length of the virtual camera RANSAC works in (VINS-Mono FOCAL_LENGTH)
+  ClaheMode clahe = ClaheMode::kWhenDark;
+  double clahe_clip = 3.0;          // CLAHE clip limit (VINS-Mono: 3.0)
+  int clahe_tiles = 8;              // CLAHE tiles per side (VINS-Mono: 8x8)
+  double dark_mean = 60;            // [grey levels] kWhenDark: CLAHE when the frame's mean is below this
+  bool async_detection = false;     // run the detector in a worker thread (see above)
+  std::string validate() const;     // empty = valid, else names the bad value
+};
+
+struct TrackedFeature {
+  std::uint64_t id = 0;           // persistent while the feature is tracked, never reused
+  int track_length = 0;           // frames this feature has been seen in, 1 on the frame it was detected
+  cv::Point2f pixel;              // [px] in the distorted image
+  Eigen::Vector2d normalized;     // undistorted normalised coordinates (x / z, y / z)
+  Eigen::Vector2d velocity;       // [normalised units / s], from the previous frame; zero for new features
+};
+
+struct TrackingResult {
+  Time t = 0;
+  std::vector<TrackedFeature> features;  // every live feature after this frame
+  int tracked = 0;            // features carried over from the previous frame (after every check)
+  int added = 0;              // new features from the detector
+  int lost_flow = 0;          // LK found no flow
+  int rejected_fb = 0;        // forward-backward check
+  int rejected_border = 0;    // left the image (or cannot be undistorted)
+  int rejected_ransac = 0;    // fundamental-matrix outliers
+  int dropped_crowded = 0;    // inside the min-distance mask of a longer track
+  bool ransac_run = false;    // RANSAC needs 8 tracked points
+  double inlier_ratio = 1.0;  // RANSAC inliers / points tested (1 when not run)
+  bool clahe_applied = false;
+  std::vector<int> finished_lengths;  // track lengths of the features that ended at this frame
+  double ms = 0;              // [ms] wall time of track()
+};
+
+// Wraps a drover::Image as a cv::Mat without copying (CV_8UC1 or CV_8UC3); throws std::invalid_argument when the
+// image is empty or inconsistent.
+cv::Mat imageView(const Image& image);
+
+class FeatureTracker {
+ public:
+  // Throws std::invalid_argument on an invalid config or a null detector.
+  FeatureTracker(const CameraModel& camera, std::shared_ptr<KeypointDetector> detector,
+                 const FeatureTrackerConfig& config);
+  ~FeatureTracker();
+  FeatureTracker(const FeatureTracker&) = delete;
+  FeatureTracker& operator=(const FeatureTracker&) = delete;
+
+  // One frame: CV_8UC1 or CV_8UC3 of the camera's size, t strictly increasing. Throws std::invalid_argument on a
+  // wrong size, type or time.
+  TrackingResult track(Time t, const cv::Mat& image);
+  const FeatureTrackerConfig& config() const { return config_; }
+
+ private:
+  struct Tracks {  // parallel arrays, one entry per live feature
+    std::vector<std::uint64_t> ids;
+    std::vector<int> lengths;
+    std::vector<cv::Point2f> pixels;
+    std::vector<Eigen::Vector2d> normalized;
+    std::vector<Eigen::Vector2d> velocity;
+    std::size_t size() const { return ids.size(); }
+    void keep(const std::vector<unsigned char>& keep_mask);
+  };
+  cv::Mat preprocess(const cv::Mat& image, TrackingResult& result) const;
+  void flow(const cv::Mat& gray, double dt, TrackingResult& result);
+  void rejectWithFundamental(const std::vector<Eigen::Vector2d>& previous, TrackingResult& result);
+  cv::Mat crowdMask(TrackingResult& result);
+  void replenish(const cv::Mat& gray, TrackingResult& result);
+  void addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result);
+  bool inside(const cv::Point2f& p) const;
+  std::vector<unsigned char> keepFinished(std::vector<unsigned char> keep, TrackingResult& result) const;
+
+  CameraModel camera_;
+  std::shared_ptr<KeypointDetector> detector_;
+  FeatureTrackerConfig config_;
+  Tracks tracks_;
+  cv::Mat previous_gray_;
+  Time previous_t_ = 0;
+  bool has_previous_ = false;
+  std::uint64_t next_id_ = 0;
+  // Asynchronous detection: the job's frame, the frames since, and the job.
+  cv::Mat job_gray_;
+  std::vector<cv::Mat> frames_since_job_;
+  std::future<Keypoints> job_;
+};
+
+}  // namespace drover::visual

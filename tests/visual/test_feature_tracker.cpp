@@ -1,0 +1,307 @@
+// KLT tracker on synthetic sequences with known motion, and on real EuRoC frames.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <thread>
+
+#include "io/dataset.hpp"
+#include "support/shared_data.hpp"
+#include "visual/feature_tracker.hpp"
+#include "visual/gftt_detector.hpp"
+#include "visual/synthetic_frames.hpp"
+
+namespace drover::visual {
+namespace {
+
+using testing::GfttDetector;
+
+constexpr Time kFrameNs = 50'000'000;  // 20 Hz
+const cv::Size kSize(640, 480);
+
+CameraModel pinhole() {
+  CameraIntrinsics k;
+  k.width = kSize.width;
+  k.height = kSize.height;
+  k.fx = k.fy = 460;
+  k.cx = 319.5;
+  k.cy = 239.5;
+  return CameraModel(k);
+}
+
+FeatureTrackerConfig baseConfig() {
+  FeatureTrackerConfig c;
+  c.max_features = 120;
+  c.clahe = ClaheMode::kOff;
+  return c;
+}
+
+// Where each feature was first seen: frame index and pixel.
+struct Origin {
+  int frame;
+  cv::Point2f pixel;
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+}
+
+// Frame-to-frame flow errors on a sub-pixel translation: median within 0.05 px, 95 % within 0.1 px (the rest, on
+// weakly textured windows, within the 0.5 px forward-backward threshold); ids persist and lengths grow by one a frame;
+// velocity = step / f / dt.
+TEST(FeatureTracker, TracksATranslatedTextureToATenthOfAPixelAndKeepsIds) {
+  const auto canvas = testing::texture(1000, 800, 1);
+  FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(), baseConfig());
+  const cv::Point2d step(2.37, -1.61);  // [px / frame]
+  std::map<std::uint64_t, Origin> origin, previous;
+  std::vector<double> step_errors, drift, velocity_errors;
+  for (int i = 0; i < 20; ++i) {
+    const TrackingResult r = tracker.track(i * kFrameNs, testing::view(canvas, step * i, kSize));
+    for (const TrackedFeature& f : r.features) {
+      if (!origin.count(f.id)) {
+        EXPECT_EQ(f.track_length, 1);
+        EXPECT_EQ(f.velocity.norm(), 0.0);
+        origin[f.id] = {i, f.pixel};
+      } else {
+        ASSERT_EQ(previous[f.id].frame, i - 1) << "id " << f.id << " was not live in the previous frame";
+        EXPECT_EQ(f.track_length, i - origin[f.id].frame + 1) << "id " << f.id;
+        step_errors.push_back(cv::norm(cv::Point2d(f.pixel - previous[f.id].pixel) - step));
+        const Eigen::Vector2d expected_velocity(step.x / 460 / 0.05, step.y / 460 / 0.05);
+        velocity_errors.push_back((f.velocity - expected_velocity).norm() * 460 * 0.05);  // [px / frame]
+        if (i == 19)
+          drift.push_back(
+              cv::norm(cv::Point2d(f.pixel) - (cv::Point2d(origin[f.id].pixel) + step * (i - origin[f.id].frame))));
+      }
+      previous[f.id] = {i, f.pixel};
+    }
+    if (i > 0) {
+      EXPECT_GT(r.tracked, 100) << "frame " << i;
+    }
+  }
+  ASSERT_GT(step_errors.size(), 1500u);
+  EXPECT_LT(percentile(step_errors, 0.5), 0.05);
+  EXPECT_LT(percentile(step_errors, 0.95), 0.1);
+  EXPECT_LT(percentile(step_errors, 1.0), 0.5) << "within the forward-backward threshold";
+  EXPECT_LT(percentile(velocity_errors, 0.95), 0.1);
+  EXPECT_LT(percentile(drift, 0.5), 0.1) << "accumulated over up to 19 frames";
+}
+
+TEST(FeatureTracker, ReplenishmentFillsTheMaskButKeepsTheMinimumDistance) {
+  const auto canvas = testing::texture(1000, 800, 2);
+  FeatureTrackerConfig config = baseConfig();
+  config.max_features = 150;
+  config.min_distance = 30;
+  // A detector that spaces its points as asked (as VINS-Mono's goodFeaturesToTrack(min_dist)) fills the budget;
+  // one that does not (min distance 1 px) is thinned by the tracker.
+  FeatureTracker spaced(pinhole(), std::make_shared<GfttDetector>(30.0), config);
+  FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(1.0), config);
+  for (int i = 0; i < 5; ++i) {
+    const cv::Mat image = testing::view(canvas, {4.0 * i, 0}, kSize);
+    EXPECT_EQ(static_cast<int>(spaced.track(i * kFrameNs, image).features.size()), config.max_features) << i;
+    const TrackingResult r = tracker.track(i * kFrameNs, image);
+    EXPECT_GT(static_cast<int>(r.features.size()), 100) << "frame " << i;
+    for (std::size_t a = 0; a < r.features.size(); ++a)
+      for (std::size_t b = a + 1; b < r.features.size(); ++b)
+        ASSERT_GE(cv::norm(r.features[a].pixel - r.features[b].pixel), config.min_distance - 1.0) << "frame " << i;
+  }
+}
+
+// A camera translating along x past a 4x4 checkerboard of blocks at different depths (2 to 6 px/frame, all
+// horizontal: one epipolar geometry; the speeds are shuffled so that no single plane, e.g. a tilted ground, explains
+// them, which would leave the fundamental matrix undetermined); eight 80 px patches move on their own, each in another
+// direction with at least 8 px/frame across the epipolar lines (independently moving objects). The RANSAC must drop
+// their tracks. (With frame-to-frame motions of a few pixels a 1 px threshold leaves the epipolar geometry loose, so
+// what RANSAC can catch are gross outliers; smaller independent motions may fit some other F.)
+TEST(FeatureTracker, FundamentalRansacDropsIndependentlyMovingPoints) {
+  const auto background = testing::texture(1200, 800, 3);
+  const auto patch_texture = testing::texture(800, 600, 5);
+  const std::vector<cv::Point> patches = {{40, 40},   {260, 60},  {520, 40},  {40, 290},
+                                          {280, 200}, {520, 300}, {160, 390}, {420, 380}};
+  const std::vector<cv::Point2d> motion = {{0, 9}, {6, -8}, {-6, 8}, {0, -9}, {5, 9}, {-5, -9}, {6, -8}, {-3, -9}};
+  const int patch = 80;
+  auto patchRect = [&](std::size_t k, int i, int margin) {
+    return cv::Rect(static_cast<int>(patches[k].x + motion[k].x * i) + margin,
+                    static_cast<int>(patches[k].y + motion[k].y * i) + margin, patch - 2 * margin, patch - 2 * margin);
+  };
+  auto frame = [&](int i) {
+    cv::Mat image(kSize, CV_8UC1);
+    const double speed[4][4] = {{2, 6, 3, 5}, {4.5, 2.5, 5.5, 3.5}, {6, 3, 2, 4}, {3.5, 5, 4, 2.5}};  // [px / frame]
+    for (int row = 0; row < 4; ++row)
+      for (int col = 0; col < 4; ++col)
+        testing::paint(image, background, {speed[row][col] * i, 0}, cv::Rect(160 * col, 120 * row, 160, 120));
+    for (std::size_t k = 0; k < patches.size(); ++k)
+      testing::paint(image, patch_texture, motion[k] * i, patchRect(k, i, 0), {0, 0});
+    return image;
+  };
+  FeatureTrackerConfig config = baseConfig();
+  config.min_distance = 12;
+  config.max_features = 300;
+  FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(12), config);
+  int rejected = 0;
+  for (int i = 0; i < 5; ++i) {
+    const TrackingResult r = tracker.track(i * kFrameNs, frame(i));
+    if (i == 0) continue;
+    EXPECT_TRUE(r.ransac_run);
+    rejected += r.rejected_ransac;
+    for (const TrackedFeature& f : r.features) {
+      if (f.track_length < 2) continue;
+      for (std::size_t k = 0; k < patches.size(); ++k)
+        // 15 px inside: the whole 21 px LK window lay on the patch in both frames (windows straddling its edge
+        // mix the two motions and may look consistent)
+        EXPECT_FALSE(patchRect(k, i, 15).contains(f.pixel))
+            << "frame " << i << ": a track on moving patch " << k << " survived: id " << f.id << " at " << f.pixel
+            << " moved " << (f.velocity * 0.05 * 460).transpose() << " ratio " << r.inlier_ratio << " rejected "
+            << r.rejected_ransac << " tracked " << r.tracked;
+    }
+  }
+  EXPECT_GT(rejected, 20);
+}
+
+// A textured board appears in front of part of the scene at frame 3: points there are occluded. Without the
+// forward-backward check many of them are "tracked" onto the board; the check drops at least 90 % of those (a
+// random texture can return a wrong match that also tracks back, so not always all).
+// (Points within half a window of the board's edge are ambiguous and not counted.)
+int wrongTracksAfterOcclusion(bool forward_backward) {
+  const auto canvas = testing::texture(1000, 800, 6);
+  const cv::Mat board = testing::view(testing::texture(640, 480, 7), {0, 0}, kSize, {0, 0});
+  FeatureTrackerConfig config = baseConfig();
+  config.ransac = false;  // attribute the rejections to the flow checks alone
+  config.forward_backward = forward_backward;
+  config.max_features = 200;
+  config.min_distance = 15;
+  FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(15), config);
+  std::map<std::uint64_t, cv::Point2f> previous;
+  int wrong = 0;
+  const cv::Rect occluder(160, 120, 320, 240);
+  for (int i = 0; i < 5; ++i) {
+    cv::Mat image = testing::view(canvas, {1.5 * i, 0.5 * i}, kSize);
+    if (i >= 3) board(occluder).copyTo(image(occluder));
+    const TrackingResult r = tracker.track(i * kFrameNs, image);
+    for (const TrackedFeature& f : r.features) {
+      // Points well inside the occluder (their whole LK window covered) that survive with a wrong position.
+      const cv::Rect interior(occluder.x + 12, occluder.y + 12, occluder.width - 24, occluder.height - 24);
+      if (i == 3 && previous.count(f.id) && interior.contains(previous[f.id]) &&
+          cv::norm(f.pixel - (previous[f.id] + cv::Point2f(1.5f, 0.5f))) > 0.5)
+        ++wrong;
+      previous[f.id] = f.pixel;
+    }
+  }
+  return wrong;
+}
+
+TEST(FeatureTracker, ForwardBackwardCheckDropsOccludedPoints) {
+  const int without = wrongTracksAfterOcclusion(false), with = wrongTracksAfterOcclusion(true);
+  EXPECT_GT(without, 10) << "the test scene must produce wrong tracks without the check";
+  EXPECT_LE(with, without / 10) << "without the check: " << without;
+}
+
+TEST(FeatureTracker, SynchronousModeIsDeterministic) {
+  const auto canvas = testing::texture(1000, 800, 8);
+  FeatureTracker a(pinhole(), std::make_shared<GfttDetector>(), baseConfig());
+  FeatureTracker b(pinhole(), std::make_shared<GfttDetector>(), baseConfig());
+  for (int i = 0; i < 6; ++i) {
+    const cv::Mat image = testing::view(canvas, {3.1 * i, 1.2 * i}, kSize);
+    const TrackingResult ra = a.track(i * kFrameNs, image), rb = b.track(i * kFrameNs, image);
+    ASSERT_EQ(ra.features.size(), rb.features.size());
+    for (std::size_t k = 0; k < ra.features.size(); ++k) {
+      EXPECT_EQ(ra.features[k].id, rb.features[k].id);
+      EXPECT_EQ(ra.features[k].pixel, rb.features[k].pixel);
+    }
+  }
+}
+
+// A slow detector (60 ms) in the worker while frames arrive every 25 ms: its points, found in frame k, are added at
+// a later frame j, carried there by the flow: each lies within 0.5 px (median 0.1 px) of where the detected point
+// moved to (its position in frame k + (j - k) steps).
+TEST(FeatureTracker, AsyncDetectionAddsPointsCarriedToTheCurrentFrame) {
+  const auto canvas = testing::texture(1000, 800, 9);
+  FeatureTrackerConfig config = baseConfig();
+  config.async_detection = true;
+  config.max_features = 400;  // more than the texture yields at 30 px: the tracker keeps asking for points
+  auto detector = std::make_shared<GfttDetector>(30, 60);
+  FeatureTracker tracker(pinhole(), detector, config);
+  const cv::Point2d step(2.0, 1.0);
+  std::vector<cv::Mat> frames;
+  std::vector<std::pair<int, cv::Point2f>> added_later;  // (frame, pixel)
+  for (int i = 0; i < 12; ++i) {
+    frames.push_back(testing::view(canvas, step * i, kSize));
+    const TrackingResult r = tracker.track(i * kFrameNs, frames.back());
+    for (const TrackedFeature& f : r.features)
+      if (i > 0 && f.track_length == 1) added_later.emplace_back(i, f.pixel);
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  }
+  ASSERT_GT(added_later.size(), 0u) << "the worker's detections were added";
+  std::vector<double> errors;
+  const std::lock_guard<std::mutex> lock(detector->mutex);
+  for (const auto& [j, pixel] : added_later) {
+    double best = 1e9;  // distance to the nearest detection of an earlier frame, moved to frame j
+    for (const auto& [image, points] : detector->history) {
+      int k = 0;
+      while (k < j && cv::norm(frames[k], image, cv::NORM_INF) != 0) ++k;
+      if (k == j) continue;
+      for (const cv::Point2f& q : points)
+        best = std::min(best, cv::norm(cv::Point2d(pixel) - (cv::Point2d(q) + step * (j - k))));
+    }
+    errors.push_back(best);
+  }
+  EXPECT_LT(percentile(errors, 0.5), 0.1);
+  EXPECT_LT(percentile(errors, 1.0), 0.5);
+}
+
+TEST(FeatureTracker, RejectsBadConfigImagesAndTimes) {
+  FeatureTrackerConfig bad = baseConfig();
+  bad.flow_window = 20;
+  EXPECT_NE(bad.validate().find("flow_window"), std::string::npos);
+  EXPECT_THROW(FeatureTracker(pinhole(), std::make_shared<GfttDetector>(), bad), std::invalid_argument);
+  EXPECT_THROW(FeatureTracker(pinhole(), nullptr, baseConfig()), std::invalid_argument);
+  FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(), baseConfig());
+  EXPECT_THROW(tracker.track(0, cv::Mat(100, 100, CV_8UC1)), std::invalid_argument);
+  const cv::Mat image = testing::view(testing::texture(640, 480, 1), {0, 0}, kSize, {0, 0});
+  tracker.track(10, image);
+  EXPECT_THROW(tracker.track(10, image), std::invalid_argument);
+}
+
+// 95 real frames of EuRoC V1_01 (752x480, 20 Hz, rad-tan lens) through the reader: tracks live for many frames,
+// RANSAC keeps most of them, the budget stays nearly full.
+TEST(FeatureTracker, OnEurocFramesTracksAreLongAndMostlyInliers) {
+  const auto path = test::sharedData("euroc/V1_01_easy_micro");
+  DROVER_REQUIRE_SHARED(path / "mav0/cam0/data");
+  io::DatasetOptions options;
+  options.load_imu = false;
+  options.load_lidar = false;
+  const auto reader = io::openDataset(path.string(), "euroc", options);
+  FeatureTracker tracker(CameraModel(reader->calibration().camera), std::make_shared<GfttDetector>(30),
+                         FeatureTrackerConfig{});
+  std::vector<int> finished;
+  double inlier_sum = 0, features_sum = 0;
+  int frames = 0, ransac_frames = 0;
+  while (auto m = reader->next()) {
+    const auto* frame = std::get_if<CameraFrame>(&*m);
+    if (!frame) continue;
+    const TrackingResult r = tracker.track(frame->t, imageView(frame->image));
+    finished.insert(finished.end(), r.finished_lengths.begin(), r.finished_lengths.end());
+    features_sum += static_cast<double>(r.features.size());
+    if (r.ransac_run) {
+      inlier_sum += r.inlier_ratio;
+      ++ransac_frames;
+    }
+    ++frames;
+  }
+  ASSERT_GE(frames, 90);
+  ASSERT_GT(finished.size(), 20u);
+  double mean_length = 0;
+  for (int l : finished) mean_length += l;
+  mean_length /= static_cast<double>(finished.size());
+  EXPECT_GT(mean_length, 6.0);
+  EXPECT_LT(mean_length, 95.0);
+  EXPECT_GT(inlier_sum / ransac_frames, 0.85);
+  EXPECT_GT(features_sum / frames, 120.0);
+  std::printf("EuRoC: %d frames, %.1f features/frame, mean finished track length %.1f, inlier ratio %.3f\n", frames,
+              features_sum / frames, mean_length, inlier_sum / ransac_frames);
+}
+
+}  // namespace
+}  // namespace drover::visual
