@@ -66,6 +66,7 @@ struct LoopClosure::Impl {
   std::vector<double> degenerate_before;  // by keyframe: degenerate directions reported up to it (cumulative)
   std::vector<LoopEvent> events;
   LoopStats stats;
+  VisualYawPrior visual_prior;
   int skip = 0;
 
   explicit Impl(const LoopClosureConfig& c)
@@ -148,6 +149,12 @@ std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map,
   if (config.source != LoopSource::kRadius) {
     auto t0 = Clock::now();
     auto prior = [&](int id) -> std::optional<double> {
+      if (visual_prior) {
+        if (std::optional<double> v = visual_prior(times[static_cast<std::size_t>(id)], times[index])) {
+          ++stats.visual_priors;
+          return v;
+        }
+      }
       if (!config.yaw_prior) return std::nullopt;
       return yawOf(map.keyframe(static_cast<std::size_t>(id)).T_world_lidar.linear().transpose() *
                    T_world_query.linear());
@@ -264,6 +271,8 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
                                       "drift budget {:.2f} m over {:.1f} m of path ({})",
                                       e.implied_drift, e.drift_budget, path, e.verification.reason);
 }
+
+void LoopClosure::setVisualYawPrior(VisualYawPrior prior) { impl_->visual_prior = std::move(prior); }
 
 std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
   std::vector<Eigen::Isometry3d> out;

@@ -11,7 +11,9 @@
 // the sweeps since the previous keyframe, degenerate_sigma per such sweep: a loop then bends the trajectory where
 // the lidar could not see (a featureless corridor) rather than everywhere. Deterministic, single-threaded.
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,8 +75,14 @@ struct LoopStats {
   std::size_t verified = 0, accepted = 0;
   std::size_t over_drift_budget = 0;  // verified by scan matching but rejected by the drift budget
   std::size_t narrowed_searches = 0, fallbacks = 0;  // prior-narrowed shift searches, and their fall-backs
+  std::size_t visual_priors = 0;     // shift searches whose prior came from the VisualYawPrior
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
 };
+
+// A yaw prior from another subsystem (the VIS's relative rotation between two keyframes' times, when it tracked
+// through both): the yaw [rad] of the query keyframe's lidar in the candidate's, p_candidate = Rz(yaw) p_query, or
+// nothing when it has none. Arguments: candidate and query keyframe times [ns].
+using VisualYawPrior = std::function<std::optional<double>(Time t_candidate, Time t_query)>;
 
 class LoopClosure {
  public:
@@ -88,6 +96,10 @@ class LoopClosure {
   // the sum over the sweeps since the previous keyframe of d d^T for each unit degenerate direction d ([rho; phi],
   // lidar frame). Returns true when a loop was accepted and the graph re-solved: then poses() differ from the map's.
   bool addKeyframe(const lidar::LocalMap& map, std::size_t index, const geometry::Matrix6d& degenerate_cov);
+
+  // The shift search's prior comes from `prior` when it returns one, else from the current estimate (when
+  // config.yaw_prior). An empty function removes it. The VIS fills this in later; until then only the estimate.
+  void setVisualYawPrior(VisualYawPrior prior);
 
   std::vector<Eigen::Isometry3d> poses() const;  // T_world_lidar of every keyframe from the graph, by index
   bool searched(std::size_t index) const;        // keyframe `index` was queried for loops (not skipped)

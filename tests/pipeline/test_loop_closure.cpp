@@ -105,6 +105,55 @@ TEST(LoopClosure, ATwinPlaceThirtyMetresAwayFitsPerfectlyButIsRejectedByTheDrift
   EXPECT_GE(twins, 5);
 }
 
+// Runs the exact (drift-free) lap with the given config and optional visual prior; returns the loop closure.
+std::unique_ptr<LoopClosure> exactLap(const LoopClosureConfig& c, VisualYawPrior prior = {}) {
+  auto loops = std::make_unique<LoopClosure>(c);
+  loops->setVisualYawPrior(std::move(prior));
+  lidar::LocalMap map;
+  for (int i = 0; i <= 40; ++i) {
+    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
+    f.t = fromSeconds(i);
+    if (loops->addKeyframe(map, map.addKeyframe(f, lapPose(i)), geometry::Matrix6d::Zero())) {
+      const std::vector<Eigen::Isometry3d> poses = loops->poses();
+      for (std::size_t k = 0; k < poses.size(); ++k) map.updatePose(k, poses[k]);
+    }
+  }
+  return loops;
+}
+
+TEST(LoopClosure, TheRadiusSourceFindsTheStartAgainFromTheEstimateAlone) {
+  LoopClosureConfig c = courtyardConfig();
+  c.source = LoopSource::kRadius;
+  c.radius = 3.0;
+  const auto loops = exactLap(c);
+  ASSERT_GE(loops->stats().accepted, 1u);
+  for (const LoopEvent& e : loops->events()) {
+    EXPECT_EQ(e.source, "radius");
+    EXPECT_LT(e.sc_distance, 0.0);  // no Scan Context involved
+    if (e.verification.accepted) {
+      EXPECT_LT(e.implied_drift, 0.25);
+    }
+  }
+}
+
+TEST(LoopClosure, AVisualYawPriorIsUsedForTheShiftSearchWhenItHasOne) {
+  int asked = 0;
+  // The lap's true relative yaw, as a VIS that tracked through both keyframes would give it.
+  const auto loops = exactLap(courtyardConfig(), [&](Time t_candidate, Time t_query) -> std::optional<double> {
+    ++asked;
+    const Eigen::Matrix3d R = (lapPose(int(toSeconds(t_candidate))).linear().transpose() *
+                               lapPose(int(toSeconds(t_query))).linear());
+    return std::atan2(R(1, 0), R(0, 0));
+  });
+  EXPECT_GT(asked, 0);
+  EXPECT_EQ(loops->stats().visual_priors, static_cast<std::size_t>(asked));
+  EXPECT_GE(loops->stats().accepted, 1u);
+  for (const LoopEvent& e : loops->events())
+    if (e.verification.accepted) {
+      EXPECT_TRUE(e.narrowed && !e.fell_back);
+    }
+}
+
 TEST(LoopClosure, DisabledItStillKeepsTheGraphButNeverSearches) {
   LoopClosureConfig c = courtyardConfig();
   c.enabled = false;
