@@ -1,11 +1,10 @@
 #include "loop/loop_verifier.hpp"
 
-#include <cmath>
-#include <stdexcept>
-
 #include <fmt/format.h>
 
+#include <cmath>
 #include <numbers>
+#include <stdexcept>
 
 namespace drover::loop {
 

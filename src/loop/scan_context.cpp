@@ -119,8 +119,16 @@ double columnDistance(const ScanContext& a_in, const ScanContext& b_in, int shif
   ScanContext a_own, b_own;
   const ScanContext* a = &a_in;
   const ScanContext* b = &b_in;
-  if (!hasUnitColumns(a_in)) a_own = a_in, fillUnitColumns(a_own), a = &a_own;
-  if (!hasUnitColumns(b_in)) b_own = b_in, fillUnitColumns(b_own), b = &b_own;
+  if (!hasUnitColumns(a_in)) {
+    a_own = a_in;
+    fillUnitColumns(a_own);
+    a = &a_own;
+  }
+  if (!hasUnitColumns(b_in)) {
+    b_own = b_in;
+    fillUnitColumns(b_own);
+    b = &b_own;
+  }
   const int sectors = static_cast<int>(a->image.cols());
   double sum = 0;
   int count = 0;
