@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Drover's main job. Installs what is missing, builds, then
 #  1. generates the simulated farm course once (out/sim/farm, cached: delete the folder to regenerate) and runs the
-#     lidar-inertial odometry on it (out/farm: trajectory, map, report, APE) -- Drover's default dataset;
+#     lidar-inertial odometry with loop closure on it (out/farm: trajectory, map, report with loops, APE) --
+#     Drover's default dataset;
 #  2. runs the lidar odometry on the shared KITTI odometry snippet (sequence 00, frames 0-9; out/kitti00).
 # Results go to out/ (override with DROVER_OUT).
 set -euo pipefail
