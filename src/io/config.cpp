@@ -8,6 +8,7 @@
 #include <initializer_list>
 
 #include "io/error.hpp"
+#include "io/yaml_section.hpp"
 #include "io/text_parsing.hpp"
 
 namespace drover::io {
@@ -187,15 +188,8 @@ Eigen::Isometry3d rigidTransformFromRowMajor(const std::vector<double>& v, const
 }
 
 DatasetOptions loadDatasetOptions(const std::string& yaml_path) {
-  if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
-  YAML::Node root;
-  try {
-    root = YAML::Load(readYamlText(yaml_path));
-  } catch (const YAML::Exception& e) {
-    fail(yaml_path, lineRecord(static_cast<std::size_t>(e.mark.line + 1)), "invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = loadConfigRoot(yaml_path);
   if (root.IsNull()) return {};  // an empty file: all defaults
-  if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
   // Every module's section is known here, so a misspelt one ("odometri:") cannot be silently ignored.
   static const std::vector<std::string> known = {"dataset", "calibration", "sim", "odometry", "loop", "visual"};
   for (const auto& kv : root) {

@@ -7,6 +7,7 @@
 
 #include "io/config.hpp"
 #include "io/error.hpp"
+#include "io/yaml_section.hpp"
 #include "io/sim_dataset.hpp"
 #include "io/text_parsing.hpp"
 
@@ -73,16 +74,9 @@ void readKey(const YAML::Node& n, const std::string& key, const std::string& fil
 }  // namespace
 
 SimConfigSettings loadSimConfigSettings(const std::string& yaml_path) {
-  if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
-  YAML::Node root;
-  try {
-    root = YAML::Load(readYamlText(yaml_path));
-  } catch (const YAML::Exception& e) {
-    fail(yaml_path, lineRecord(static_cast<std::size_t>(e.mark.line + 1)), "invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = loadConfigRoot(yaml_path);
   SimConfigSettings s;
   if (root.IsNull()) return s;
-  if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
   const YAML::Node sim = root["sim"];
   if (!sim || sim.IsNull()) return s;
   if (!sim.IsMap()) fail(yaml_path, "key 'sim'", "expected a map of settings");

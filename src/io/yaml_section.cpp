@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
+#include "io/config.hpp"
 #include "io/error.hpp"
 #include "io/text_parsing.hpp"
 
@@ -93,6 +95,18 @@ void YamlSection::apply(const YAML::Node& node) const {
       fail(file_, record(kv.first, dotted), "unknown key (expected one of: " + known + ")");
     }
   }
+}
+
+YAML::Node loadConfigRoot(const std::string& yaml_path) {
+  if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
+  YAML::Node root;
+  try {
+    root = YAML::Load(readYamlText(yaml_path));
+  } catch (const YAML::Exception& e) {
+    fail(yaml_path, lineRecord(static_cast<std::size_t>(e.mark.line + 1)), "invalid YAML: " + e.msg);
+  }
+  if (!root.IsNull() && !root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
+  return root;
 }
 
 }  // namespace drover::io

@@ -14,6 +14,11 @@ class Node;
 
 namespace drover::io {
 
+// The top level of a platform config file (config/*.yaml): a null node for an empty file, else a map. Throws IoError
+// naming the file for a missing file, invalid YAML (with its line) or a top level that is not a map. Shared by every
+// reader of a config section (dataset, sim, odometry, loop, visual).
+YAML::Node loadConfigRoot(const std::string& yaml_path);
+
 class YamlSection {
  public:
   // `prefix` names the section in messages, e.g. "odometry.matcher".

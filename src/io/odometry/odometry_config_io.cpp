@@ -115,16 +115,9 @@ void applyEnums(const EnumStrings& e, pipeline::OdometryConfig& c) {
 }  // namespace
 
 pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
-  if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
-  YAML::Node root;
-  try {
-    root = YAML::Load(readYamlText(yaml_path));
-  } catch (const YAML::Exception& e) {
-    fail(yaml_path, lineRecord(static_cast<std::size_t>(e.mark.line + 1)), "invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = loadConfigRoot(yaml_path);
   pipeline::OdometryConfig c;
   if (root.IsNull()) return c;
-  if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
   EnumStrings e;
   const lidar::FeatureExtractorConfig& fc = c.features;
   FeatureFloats f{fc.edge_threshold, fc.surf_threshold, fc.occlusion_depth_gap, fc.parallel_ratio,
