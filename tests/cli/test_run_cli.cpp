@@ -170,6 +170,8 @@ class SimRun : public ::testing::Test {
       (imu ? imu_ : lidar_) = runDrover("run " + data().string() + " --format sim --config " +
                                         config("farm_sim.yaml") + " --out " + out(imu).string() +
                                         (imu ? "" : " --no-imu"));
+    noloop_ = runDrover("run " + data().string() + " --format sim --config " + config("farm_sim.yaml") + " --out " +
+                        (*dir_ / "run_noloop").string() + " --no-loop -q");
   }
   static void TearDownTestSuite() { dir_.reset(); }
   void SetUp() override { ASSERT_EQ(sim_.exit_code, 0) << sim_.output; }
@@ -189,7 +191,7 @@ class SimRun : public ::testing::Test {
   }
 
   static inline std::unique_ptr<TempDir> dir_;
-  static inline CliResult sim_, imu_, lidar_;
+  static inline CliResult sim_, imu_, lidar_, noloop_;
 };
 
 TEST_F(SimRun, WithTheImuTheRunIsLidarPlusImuWithOnePosePerSweepInTheImuFrame) {
@@ -213,6 +215,27 @@ TEST_F(SimRun, WithoutTheImuTheRunIsLidarOnlyAndStillInTheImuFrame) {
   EXPECT_EQ(r["counts"]["imu_scans"], 0);
   EXPECT_NEAR(static_cast<double>(io::readTum((out(false) / "trajectory.tum").string()).size()), 40.0, 1.0);
   expectImuHeightAboveTheMapGround(false);
+}
+
+TEST_F(SimRun, TheReportCarriesTheLoopRecordAndNoLoopTurnsTheSearchOff) {
+  ASSERT_EQ(imu_.exit_code, 0) << imu_.output;
+  const Json r = readJson(out(true) / "report.json");
+  ASSERT_TRUE(r.contains("loops"));
+  const Json& loops = r["loops"];
+  EXPECT_EQ(loops["enabled"], true);
+  EXPECT_EQ(loops["source"], "scancontext");
+  // Every keyframe is searched (none is skipped without an accepted loop); a straight 4 s course revisits nothing.
+  EXPECT_EQ(loops["queries"], r["counts"]["keyframes"]);
+  EXPECT_EQ(loops["accepted"], 0);
+  EXPECT_TRUE(loops["events"].is_array());
+  EXPECT_EQ(loops["precision"], 1.0);  // with ground truth: judged (no loop, so nothing false)
+  EXPECT_EQ(loops["searched_keyframes_with_revisit"], 0);
+  EXPECT_TRUE(r["timings"].contains("loop"));
+
+  ASSERT_EQ(noloop_.exit_code, 0) << noloop_.output;
+  const Json n = readJson(*dir_ / "run_noloop" / "report.json");
+  EXPECT_EQ(n["loops"]["enabled"], false);
+  EXPECT_EQ(n["loops"]["queries"], 0);
 }
 
 // The course stands still for about 2.3 s, then accelerates to 0.72 m by 3.9 s; starting from rest against a single
