@@ -361,5 +361,56 @@ TEST(OdometryConfigReader, InvalidYamlIsAnErrorNamingFileAndLine) {
   EXPECT_TRUE(has(e, (dir / "odometry.yaml").string()) && has(e, "invalid YAML") && has(e, "line ")) << e;
 }
 
+TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
+  test::TempDir dir;
+  const OdometryConfig c = load(dir, R"(loop:
+  enabled: false
+  source: both
+  min_age: 12.5
+  max_drift_ratio: 0.2
+  scan_context:
+    sensor_height: 1.5
+    auto_height: true
+    threshold: 0.2
+    search_radius: 4
+    candidates: 7
+    exclude_recent: 20
+  verifier:
+    max_fitness: 0.3
+    min_inliers: 50
+  graph:
+    loop_loss: cauchy
+    loop_loss_scale: 2.0
+odometry:
+  matcher:
+    max_iterations: 17
+)");
+  EXPECT_FALSE(c.loop.enabled);
+  EXPECT_EQ(c.loop.source, pipeline::LoopSource::kBoth);
+  EXPECT_EQ(c.loop.min_age, 12.5);
+  EXPECT_EQ(c.loop.max_drift_ratio, 0.2);
+  EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
+  EXPECT_TRUE(c.loop.database.descriptor.auto_height);
+  EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);
+  EXPECT_EQ(c.loop.database.descriptor.search_radius, 4);
+  EXPECT_EQ(c.loop.database.candidates, 7);
+  EXPECT_EQ(c.loop.database.exclude_recent, 20);
+  EXPECT_EQ(c.loop.verifier.max_fitness, 0.3);
+  EXPECT_EQ(c.loop.verifier.min_inliers, 50);
+  EXPECT_EQ(c.loop.graph.loop_loss, backend::RobustLoss::kCauchy);
+  EXPECT_EQ(c.loop.graph.loop_loss_scale, 2.0);
+  EXPECT_EQ(c.loop.verifier.matcher.max_iterations, 17);  // the verifier matches as the odometry does
+}
+
+TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {
+  test::TempDir dir;
+  std::string e = errorOf(dir, "loop:\n  scan_context:\n    rings: 20\n    ring: 20\n");
+  EXPECT_TRUE(has(e, "line 4") && has(e, "loop.scan_context.ring")) << e;
+  e = errorOf(dir, "loop:\n  source: scan-context\n");
+  EXPECT_TRUE(has(e, "line 2") && has(e, "loop.source") && has(e, "scancontext")) << e;
+  e = errorOf(dir, "loop:\n  scan_context:\n    threshold: 5\n");
+  EXPECT_TRUE(has(e, "threshold")) << e;
+}
+
 }  // namespace
 }  // namespace drover::io
