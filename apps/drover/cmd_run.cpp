@@ -124,7 +124,8 @@ void runOdometry(const RunOptions& o) {
 }  // namespace
 
 void registerRun(CLI::App& app) {
-  auto* cmd = app.add_subcommand("run", "Lidar-inertial odometry with loop closure over a dataset; writes trajectory, map and report");
+  auto* cmd = app.add_subcommand(
+      "run", "Lidar-inertial odometry with loop closure over a dataset; writes trajectory, map and report");
   auto o = std::make_shared<RunOptions>();
   cmd->add_option("dataset", o->dataset, "Dataset folder or bag file")->required();
   cmd->add_option("--format", o->format, "Dataset format")
