@@ -67,10 +67,11 @@ void runPair(const PairOptions& o) {
   const double threshold = config.loop.database.descriptor.threshold;
   const Eigen::Isometry3d& T = r.icp.T_candidate_query;
   spdlog::info("A: {} ({} points), B: {} ({} points)", o.a, r.points_a, o.b, r.points_b);
-  spdlog::info("scan context: distance {:.4f} ({} threshold {:.2f}), shift {}, yaw {:.1f} deg; plain (no lateral "
-               "augmentation) {:.4f}",
-               r.match.match.distance, r.same_place ? "same place, under the" : "different places, over the",
-               threshold, r.match.match.shift, r.match.match.yaw * kDeg, r.plain.distance);
+  spdlog::info(
+      "scan context: distance {:.4f} ({} threshold {:.2f}), shift {}, yaw {:.1f} deg; plain (no lateral "
+      "augmentation) {:.4f}",
+      r.match.match.distance, r.same_place ? "same place, under the" : "different places, over the", threshold,
+      r.match.match.shift, r.match.match.yaw * kDeg, r.plain.distance);
   spdlog::info("icp: {}; T_A_B translation ({:.3f}, {:.3f}, {:.3f}) m, yaw {:.2f} deg", r.icp.reason,
                T.translation().x(), T.translation().y(), T.translation().z(),
                std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * kDeg);
@@ -90,8 +91,9 @@ void runPair(const PairOptions& o) {
 }
 
 void registerPair(CLI::App& loop) {
-  auto* cmd = loop.add_subcommand("pair", "Scan Context distance, shift and yaw of two KITTI .bin scans, and the "
-                                          "scan match of B onto A that would verify the loop");
+  auto* cmd = loop.add_subcommand("pair",
+                                  "Scan Context distance, shift and yaw of two KITTI .bin scans, and the "
+                                  "scan match of B onto A that would verify the loop");
   auto o = std::make_shared<PairOptions>();
   cmd->add_option("a", o->a, "Scan A (.bin: float32 x, y, z, reflectance), the earlier visit")->required();
   cmd->add_option("b", o->b, "Scan B (.bin), the query")->required();

@@ -50,8 +50,8 @@ std::string rejection(const LoopVerification& v, const lidar::MatchResult& r, co
     return fmt::format("inlier ratio {:.2f} < {:.2f}", v.inlier_ratio, c.min_inlier_ratio);
   if (v.correction_translation > c.max_correction_translation || v.correction_rotation > c.max_correction_rotation)
     return fmt::format("solution {:.2f} m / {:.1f} deg from the guess (limits {:.2f} m / {:.1f} deg)",
-                       v.correction_translation, v.correction_rotation * 180 / std::numbers::pi, c.max_correction_translation,
-                       c.max_correction_rotation * 180 / std::numbers::pi);
+                       v.correction_translation, v.correction_rotation * 180 / std::numbers::pi,
+                       c.max_correction_translation, c.max_correction_rotation * 180 / std::numbers::pi);
   return {};
 }
 
@@ -61,8 +61,8 @@ LoopVerification LoopVerifier::verify(const lidar::FeatureSet& query, std::span<
                                       std::size_t candidate, const Eigen::Isometry3d& T_candidate_query_guess) const {
   if (submap.empty()) throw std::invalid_argument("loop verifier: empty submap");
   if (candidate >= submap.size())
-    throw std::invalid_argument(fmt::format("loop verifier: candidate {} outside the submap of {}", candidate,
-                                            submap.size()));
+    throw std::invalid_argument(
+        fmt::format("loop verifier: candidate {} outside the submap of {}", candidate, submap.size()));
   if (!T_candidate_query_guess.matrix().allFinite()) throw std::invalid_argument("loop verifier: non-finite guess");
   const Eigen::Isometry3d T_candidate_world = submap[candidate].T_world_lidar.inverse();
   // Every submap keyframe is kept (no radius or density selection): the caller chose them.

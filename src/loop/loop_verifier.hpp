@@ -23,17 +23,17 @@
 namespace drover::loop {
 
 struct LoopVerifierConfig {
-  lidar::ScanMatcherConfig matcher;     // the odometry's matcher settings (max_iterations, kernels, ...)
-  lidar::LocalMapConfig submap;         // leaves of the candidate submap (radius and density are not used: every
-                                        // submap keyframe given is kept)
-  double max_fitness = 0.25;            // [m] RMS point-to-feature distance at the solution
-  int min_inliers = 100;                // [-] accepted edge + plane correspondences at the solution
-  double min_inlier_ratio = 0.35;       // [-] of the query's edges + planes
+  lidar::ScanMatcherConfig matcher;         // the odometry's matcher settings (max_iterations, kernels, ...)
+  lidar::LocalMapConfig submap;             // leaves of the candidate submap (radius and density are not used: every
+                                            // submap keyframe given is kept)
+  double max_fitness = 0.25;                // [m] RMS point-to-feature distance at the solution
+  int min_inliers = 100;                    // [-] accepted edge + plane correspondences at the solution
+  double min_inlier_ratio = 0.35;           // [-] of the query's edges + planes
   double max_correction_translation = 4.0;  // [m] |translation| of guess^-1 * solution
   double max_correction_rotation = 0.35;    // [rad] angle of guess^-1 * solution (20 deg)
-  double sigma_floor_position = 0.05;   // [m] added in quadrature to the fit's position sigma
-  double sigma_floor_rotation = 0.005;  // [rad] added in quadrature to the fit's rotation sigma
-  std::string validate() const;         // empty when valid
+  double sigma_floor_position = 0.05;       // [m] added in quadrature to the fit's position sigma
+  double sigma_floor_rotation = 0.005;      // [rad] added in quadrature to the fit's rotation sigma
+  std::string validate() const;             // empty when valid
 };
 
 // One keyframe of the candidate's submap: its features (lidar frame) and pose in any common frame.
@@ -50,9 +50,9 @@ struct LoopVerification {
   std::string match_status;  // lidar::toString(MatchStatus)
   bool converged = false, degenerate = false;
   int iterations = 0;
-  double fitness = 0;              // [m] RMS point-to-feature distance
-  int inliers = 0;                 // edge + plane correspondences
-  double inlier_ratio = 0;         // inliers / (query edges + planes)
+  double fitness = 0;                 // [m] RMS point-to-feature distance
+  int inliers = 0;                    // edge + plane correspondences
+  double inlier_ratio = 0;            // inliers / (query edges + planes)
   double correction_translation = 0;  // [m] |guess^-1 * solution| translation
   double correction_rotation = 0;     // [rad]
   // Covariance and information of the decoupled error [dp (candidate frame, m); dphi (right, rad)] of
@@ -70,8 +70,8 @@ class LoopVerifier {
   // T_candidate_query_guess. The submap's poses may be in any world frame; candidate is the index in `submap` of
   // the candidate keyframe, whose frame the result refers to. Throws std::invalid_argument for an empty submap, a
   // bad candidate index, a null features pointer or a non-finite pose.
-  LoopVerification verify(const lidar::FeatureSet& query, std::span<const SubmapKeyframe> submap,
-                          std::size_t candidate, const Eigen::Isometry3d& T_candidate_query_guess) const;
+  LoopVerification verify(const lidar::FeatureSet& query, std::span<const SubmapKeyframe> submap, std::size_t candidate,
+                          const Eigen::Isometry3d& T_candidate_query_guess) const;
 
   const LoopVerifierConfig& config() const { return config_; }
 

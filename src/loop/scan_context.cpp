@@ -23,7 +23,8 @@ void requireSameShape(const ScanContext& a, const ScanContext& b) {
 std::string ScanContextConfig::validate() const {
   if (rings < 1 || sectors < 2) return "rings must be >= 1 and sectors >= 2";
   if (!std::isfinite(max_radius) || max_radius <= 0) return "max_radius must be finite and > 0 m";
-  if (!std::isfinite(sensor_height) || !std::isfinite(ground_lift)) return "sensor_height and ground_lift must be finite";
+  if (!std::isfinite(sensor_height) || !std::isfinite(ground_lift))
+    return "sensor_height and ground_lift must be finite";
   if (!std::isfinite(threshold) || threshold <= 0 || threshold > 2) return "threshold must be in (0, 2]";
   if (search_radius < 0) return "search_radius must be >= 0";
   if (!std::isfinite(lateral_step) || lateral_step <= 0) return "lateral_step must be finite and > 0 m";

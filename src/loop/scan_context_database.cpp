@@ -34,9 +34,9 @@ std::string ScanContextDatabaseConfig::validate() const {
 }
 
 struct ScanContextDatabase::Impl {
-  std::vector<int> ids;                   // by entry
-  std::vector<ScanContext> descriptors;   // by entry
-  std::vector<Eigen::VectorXf> ring_keys; // by entry (the tree reads them)
+  std::vector<int> ids;                    // by entry
+  std::vector<ScanContext> descriptors;    // by entry
+  std::vector<Eigen::VectorXf> ring_keys;  // by entry (the tree reads them)
   std::unordered_map<int, std::size_t> entry_of_id;
   RingKeyAdaptor adaptor;
   std::unique_ptr<RingKeyTree> tree;
@@ -59,9 +59,10 @@ ScanContextDatabase& ScanContextDatabase::operator=(ScanContextDatabase&&) noexc
 void ScanContextDatabase::add(int id, ScanContext descriptor) {
   if (descriptor.image.rows() != config_.descriptor.rings || descriptor.image.cols() != config_.descriptor.sectors)
     throw std::invalid_argument("scan context database: descriptor of entry " + std::to_string(id) + " is " +
-                                std::to_string(descriptor.image.rows()) + "x" + std::to_string(descriptor.image.cols()) +
-                                ", expected the config's rings x sectors");
-  if (impl_->entry_of_id.count(id)) throw std::invalid_argument("scan context database: duplicate id " + std::to_string(id));
+                                std::to_string(descriptor.image.rows()) + "x" +
+                                std::to_string(descriptor.image.cols()) + ", expected the config's rings x sectors");
+  if (impl_->entry_of_id.count(id))
+    throw std::invalid_argument("scan context database: duplicate id " + std::to_string(id));
   Impl& m = *impl_;
   // The tree reads ring_keys through a pointer to the vector: growing it is fine, entries never move logically.
   m.entry_of_id[id] = m.ids.size();
@@ -109,7 +110,8 @@ DatabaseQuery ScanContextDatabase::query(const AugmentedScanContext& q,
     }
   }
   std::vector<std::pair<std::uint32_t, Retrieved>> ranked(retrieved.begin(), retrieved.end());
-  std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.second.d2 < b.second.d2; });
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& a, const auto& b) { return a.second.d2 < b.second.d2; });
   if (ranked.size() > k) ranked.resize(k);
   for (const auto& [entry, r] : ranked) {
     LoopCandidate c;
@@ -138,7 +140,8 @@ std::size_t ScanContextDatabase::searchable() const { return impl_->indexed; }
 
 const ScanContext& ScanContextDatabase::descriptor(int id) const {
   auto it = impl_->entry_of_id.find(id);
-  if (it == impl_->entry_of_id.end()) throw std::invalid_argument("scan context database: unknown id " + std::to_string(id));
+  if (it == impl_->entry_of_id.end())
+    throw std::invalid_argument("scan context database: unknown id " + std::to_string(id));
   return impl_->descriptors[it->second];
 }
 

@@ -24,8 +24,8 @@ namespace drover::loop {
 
 struct ScanContextDatabaseConfig {
   ScanContextConfig descriptor;
-  int candidates = 10;       // [-] top-k keyframes by ring-key distance per query descriptor (reference: 10)
-  int exclude_recent = 50;   // [entries] the newest entries are never candidates (reference: 50 keyframes)
+  int candidates = 10;           // [-] top-k keyframes by ring-key distance per query descriptor (reference: 10)
+  int exclude_recent = 50;       // [entries] the newest entries are never candidates (reference: 50 keyframes)
   std::string validate() const;  // empty when valid
 };
 
@@ -59,8 +59,8 @@ class ScanContextDatabase {
   DatabaseQuery query(const AugmentedScanContext& query,
                       const std::function<std::optional<double>(int id)>& yaw_prior = {}) const;
 
-  std::size_t size() const;        // entries stored
-  std::size_t searchable() const;  // entries old enough to be returned
+  std::size_t size() const;                     // entries stored
+  std::size_t searchable() const;               // entries old enough to be returned
   const ScanContext& descriptor(int id) const;  // throws std::invalid_argument for an unknown id
   const ScanContextDatabaseConfig& config() const { return config_; }
 

@@ -62,15 +62,14 @@ struct LoopClosure::Impl {
   loop::LoopVerifier verifier;
   backend::PoseGraph graph;
   std::vector<Time> times;
-  std::vector<bool> searched;  // by keyframe
+  std::vector<bool> searched;             // by keyframe
   std::vector<double> degenerate_before;  // by keyframe: degenerate directions reported up to it (cumulative)
   std::vector<LoopEvent> events;
   LoopStats stats;
   VisualYawPrior visual_prior;
   int skip = 0;
 
-  explicit Impl(const LoopClosureConfig& c)
-      : config(c), database(c.database), verifier(c.verifier), graph(c.graph) {}
+  explicit Impl(const LoopClosureConfig& c) : config(c), database(c.database), verifier(c.verifier), graph(c.graph) {}
 
   void addOdometryEdge(const lidar::LocalMap& map, std::size_t index, const geometry::Matrix6d& degenerate_cov);
   std::vector<Candidate> candidates(const lidar::LocalMap& map, std::size_t index,
@@ -119,7 +118,8 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   if (!m.config.enabled) return false;
 
   auto t0 = Clock::now();
-  const loop::AugmentedScanContext query = loop::makeAugmentedScanContext(kf.features.full, m.config.database.descriptor);
+  const loop::AugmentedScanContext query =
+      loop::makeAugmentedScanContext(kf.features.full, m.config.database.descriptor);
   m.stats.descriptor_ms += msSince(t0);
   bool closed = false;
   if (m.skip > 0) {
@@ -228,15 +228,16 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
                        .shift;
   }
   auto t0 = Clock::now();
-  e.verification = verifier.verify(map.keyframe(index).features, submap, candidate_in_submap, c.T_candidate_query_guess);
+  e.verification =
+      verifier.verify(map.keyframe(index).features, submap, candidate_in_submap, c.T_candidate_query_guess);
   stats.verify_ms += msSince(t0);
   ++stats.verified;
   if (e.verification.accepted) checkDriftBudget(map, e);
   if (e.verification.accepted) {
     const Eigen::Vector3d before = graph.pose(static_cast<int>(index)).translation();
-    const std::size_t edge = graph.addEdge(static_cast<int>(c.index), static_cast<int>(index),
-                                           e.verification.T_candidate_query, e.verification.information,
-                                           backend::EdgeKind::kLoop);
+    const std::size_t edge =
+        graph.addEdge(static_cast<int>(c.index), static_cast<int>(index), e.verification.T_candidate_query,
+                      e.verification.information, backend::EdgeKind::kLoop);
     const backend::PoseGraphResult r = graph.optimize();
     e.graph_initial_cost = r.initial_cost;
     e.graph_final_cost = r.final_cost;
@@ -260,16 +261,18 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
   double path = 0;
   for (std::size_t i = e.candidate + 1; i <= e.query; ++i)
     path += (map.keyframe(i).T_world_lidar.translation() - map.keyframe(i - 1).T_world_lidar.translation()).norm();
-  const Eigen::Isometry3d T_est = map.keyframe(e.candidate).T_world_lidar.inverse() * map.keyframe(e.query).T_world_lidar;
+  const Eigen::Isometry3d T_est =
+      map.keyframe(e.candidate).T_world_lidar.inverse() * map.keyframe(e.query).T_world_lidar;
   e.implied_drift = (e.verification.T_candidate_query.translation() - T_est.translation()).norm();
   e.drift_budget = config.max_drift_floor + config.max_drift_ratio * path +
                    config.degenerate_drift * (degenerate_before[e.query] - degenerate_before[e.candidate]);
   if (e.implied_drift <= e.drift_budget) return;
   ++stats.over_drift_budget;
   e.verification.accepted = false;
-  e.verification.reason = fmt::format("rejected: the loop moves the query {:.2f} m from the estimate, more than the "
-                                      "drift budget {:.2f} m over {:.1f} m of path ({})",
-                                      e.implied_drift, e.drift_budget, path, e.verification.reason);
+  e.verification.reason = fmt::format(
+      "rejected: the loop moves the query {:.2f} m from the estimate, more than the "
+      "drift budget {:.2f} m over {:.1f} m of path ({})",
+      e.implied_drift, e.drift_budget, path, e.verification.reason);
 }
 
 void LoopClosure::setVisualYawPrior(VisualYawPrior prior) { impl_->visual_prior = std::move(prior); }
@@ -281,9 +284,7 @@ std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
   return out;
 }
 
-bool LoopClosure::searched(std::size_t index) const {
-  return index < impl_->searched.size() && impl_->searched[index];
-}
+bool LoopClosure::searched(std::size_t index) const { return index < impl_->searched.size() && impl_->searched[index]; }
 
 const std::vector<LoopEvent>& LoopClosure::events() const { return impl_->events; }
 const LoopStats& LoopClosure::stats() const { return impl_->stats; }

@@ -33,22 +33,22 @@ struct LoopClosureConfig {
   LoopSource source = LoopSource::kScanContext;
   loop::ScanContextDatabaseConfig database;  // descriptor (rings, sectors, radius, sensor height, threshold, dh)
   loop::LoopVerifierConfig verifier;
-  bool yaw_prior = true;          // narrow the shift search around the estimate's relative yaw (Eqs. 2-4)
-  double min_age = 30.0;          // [s] candidates at least this much older than the query (LIO-SAM 30 s)
-  int submap_keyframes = 10;      // [keyframes] on each side of the candidate in its verification submap
-  int max_verifications = 2;      // [-] candidates verified per keyframe at most (best Scan Context first)
-  int skip_after_loop = 2;        // [keyframes] no detection for this many keyframes after an accepted loop
-  double radius = 10.0;           // [m] radius source: nearest old keyframe within this distance (LIO-SAM 15 m)
-  double odometry_sigma_position = 0.02;   // [m] per keyframe step
+  bool yaw_prior = true;                  // narrow the shift search around the estimate's relative yaw (Eqs. 2-4)
+  double min_age = 30.0;                  // [s] candidates at least this much older than the query (LIO-SAM 30 s)
+  int submap_keyframes = 10;              // [keyframes] on each side of the candidate in its verification submap
+  int max_verifications = 2;              // [-] candidates verified per keyframe at most (best Scan Context first)
+  int skip_after_loop = 2;                // [keyframes] no detection for this many keyframes after an accepted loop
+  double radius = 10.0;                   // [m] radius source: nearest old keyframe within this distance (LIO-SAM 15 m)
+  double odometry_sigma_position = 0.02;  // [m] per keyframe step
   double odometry_sigma_rotation = 0.002;  // [rad] per keyframe step
-  double degenerate_sigma = 0.5;  // [m or rad] per degenerate sweep, along its degenerate directions
+  double degenerate_sigma = 0.5;           // [m or rad] per degenerate sweep, along its degenerate directions
   // Drift budget: a verified loop is accepted only if it moves the query (relative to the candidate) by at most
   // max_drift_floor + max_drift_ratio * (path length between them) + degenerate_drift * (degenerate directions
   // reported by the sweeps between them). A loop that needs more than the odometry can have drifted is a false
   // one (a repeated structure: identical pens, a symmetric hall), however well the scans fit.
-  double max_drift_floor = 2.0;    // [m]
-  double max_drift_ratio = 0.15;   // [-] of the path length
-  double degenerate_drift = 0.5;   // [m] per degenerate direction of a sweep
+  double max_drift_floor = 2.0;   // [m]
+  double max_drift_ratio = 0.15;  // [-] of the path length
+  double degenerate_drift = 0.5;  // [m] per degenerate direction of a sweep
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };
@@ -62,20 +62,20 @@ struct LoopEvent {
   int shift = 0;                         // [sectors]
   double sc_yaw = 0;                     // [rad] yaw of the query in the candidate frame from the shift
   bool narrowed = false, fell_back = false;
-  int full_shift = -1;                   // the full search's shift on the same descriptors (to compare; -1: radius)
+  int full_shift = -1;  // the full search's shift on the same descriptors (to compare; -1: radius)
   loop::LoopVerification verification;
   double graph_initial_cost = 0, graph_final_cost = 0, graph_ms = 0;  // of the re-solve (accepted only)
-  double correction = 0;  // [m] how far the re-solve moved the query keyframe
+  double correction = 0;                       // [m] how far the re-solve moved the query keyframe
   double implied_drift = 0, drift_budget = 0;  // [m] |loop - estimate| of the relative translation, and its limit
 };
 
 struct LoopStats {
-  std::size_t queries = 0;           // keyframes searched
-  std::size_t candidates = 0;        // Scan Context candidates under the threshold, plus radius candidates
+  std::size_t queries = 0;     // keyframes searched
+  std::size_t candidates = 0;  // Scan Context candidates under the threshold, plus radius candidates
   std::size_t verified = 0, accepted = 0;
-  std::size_t over_drift_budget = 0;  // verified by scan matching but rejected by the drift budget
+  std::size_t over_drift_budget = 0;                 // verified by scan matching but rejected by the drift budget
   std::size_t narrowed_searches = 0, fallbacks = 0;  // prior-narrowed shift searches, and their fall-backs
-  std::size_t visual_priors = 0;     // shift searches whose prior came from the VisualYawPrior
+  std::size_t visual_priors = 0;                     // shift searches whose prior came from the VisualYawPrior
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
 };
 

@@ -14,8 +14,8 @@ lidar::FeatureSet prepare(LidarScan& scan, const OdometryConfig& config, const c
   lidar::sanitize(scan, config.layout);
   points = scan.points.size();
   if (static_cast<int>(points) < config.min_points)
-    throw std::invalid_argument(fmt::format("scan {} has {} valid points (fewer than min_points = {})", name, points,
-                                            config.min_points));
+    throw std::invalid_argument(
+        fmt::format("scan {} has {} valid points (fewer than min_points = {})", name, points, config.min_points));
   if (!scan.has_time) lidar::inferTimes(scan, config.layout);
   if (!scan.has_ring) lidar::inferRings(scan, config.layout);
   return lidar::FeatureExtractor(config.features).extract(scan).features;

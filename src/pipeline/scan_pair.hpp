@@ -12,13 +12,13 @@
 namespace drover::pipeline {
 
 struct ScanPairResult {
-  loop::ShiftMatch plain;        // full shift search of the real positions (no augmentation)
-  loop::AugmentedMatch match;    // the decision: full search against B's virtual positions
-  bool same_place = false;       // match.match.distance < the descriptor threshold
+  loop::ShiftMatch plain;      // full shift search of the real positions (no augmentation)
+  loop::AugmentedMatch match;  // the decision: full search against B's virtual positions
+  bool same_place = false;     // match.match.distance < the descriptor threshold
   // B registered to A (T_candidate_query = T_A_B), tried whether or not same_place holds.
   loop::LoopVerification icp;
   Eigen::Isometry3d T_A_B_guess = Eigen::Isometry3d::Identity();  // the Scan Context guess it started from
-  std::size_t points_a = 0, points_b = 0;  // valid points after sanitising
+  std::size_t points_a = 0, points_b = 0;                         // valid points after sanitising
 };
 
 // Uses config.layout, config.features, config.loop.database.descriptor and config.loop.verifier. Throws

@@ -20,7 +20,8 @@ lidar::PointCloud place(int seed) {
   lidar::PointCloud c;
   for (int k = 0; k < 80; ++k) {
     const double r = range(rng), a = azimuth(rng), h = height(rng);
-    for (double z = 0; z <= h; z += 0.25) c.emplace_back(float(r * std::cos(a)), float(r * std::sin(a)), float(z - 2.0));
+    for (double z = 0; z <= h; z += 0.25)
+      c.emplace_back(float(r * std::cos(a)), float(r * std::sin(a)), float(z - 2.0));
   }
   return c;
 }

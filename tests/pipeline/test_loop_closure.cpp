@@ -71,8 +71,8 @@ TEST(LoopClosure, PullsADriftingLapBackOntoTheTruthWhenItReturnsToItsStart) {
   double worst_after = 0;
   for (std::size_t k = 0; k < poses.size(); ++k)
     worst_after = std::max(worst_after, (poses[k].translation() - lapPose(int(k)).translation()).norm());
-  std::printf("lap of 41 keyframes: %d loops, worst position error %.3f m before, %.3f m after\n", closed,
-              worst_before, worst_after);
+  std::printf("lap of 41 keyframes: %d loops, worst position error %.3f m before, %.3f m after\n", closed, worst_before,
+              worst_after);
   EXPECT_GT(worst_before, 1.0);
   EXPECT_LT(worst_after, 0.35 * worst_before);
   EXPECT_LT((poses.back().translation() - lapPose(40).translation()).norm(), 0.3);
@@ -99,8 +99,7 @@ TEST(LoopClosure, ATwinPlaceThirtyMetresAwayFitsPerfectlyButIsRejectedByTheDrift
   int twins = 0;
   for (const LoopEvent& e : loops.events()) {
     EXPECT_FALSE(e.verification.accepted);
-    twins += std::abs(e.implied_drift - 30.0) < 0.5 &&
-             e.verification.reason.find("drift budget") != std::string::npos;
+    twins += std::abs(e.implied_drift - 30.0) < 0.5 && e.verification.reason.find("drift budget") != std::string::npos;
   }
   EXPECT_GE(twins, 5);
 }
@@ -141,8 +140,8 @@ TEST(LoopClosure, AVisualYawPriorIsUsedForTheShiftSearchWhenItHasOne) {
   // The lap's true relative yaw, as a VIS that tracked through both keyframes would give it.
   const auto loops = exactLap(courtyardConfig(), [&](Time t_candidate, Time t_query) -> std::optional<double> {
     ++asked;
-    const Eigen::Matrix3d R = (lapPose(int(toSeconds(t_candidate))).linear().transpose() *
-                               lapPose(int(toSeconds(t_query))).linear());
+    const Eigen::Matrix3d R =
+        (lapPose(int(toSeconds(t_candidate))).linear().transpose() * lapPose(int(toSeconds(t_query))).linear());
     return std::atan2(R(1, 0), R(0, 0));
   });
   EXPECT_GT(asked, 0);
@@ -185,7 +184,7 @@ TEST(LoopClosure, RejectsInvalidConfigsAndOutOfOrderKeyframes) {
 // The simulated overlap course: 88 s, 82 m, a loop driven and then partly driven again.
 struct OverlapRun {
   Trajectory lidar_truth;  // T_world_lidar at every sweep
-  double ape = 0;  // [m] rmse, SE(3)-aligned
+  double ape = 0;          // [m] rmse, SE(3)-aligned
   std::vector<LoopEvent> events;
   LoopStats stats;
 };
@@ -231,8 +230,8 @@ Eigen::Isometry3d truthAt(const Trajectory& truth, Time t) {
 
 TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueWithTheTrueRelativePose) {
   const OverlapRun& r = overlap();
-  std::printf("overlap: %zu queries, %zu verified, %zu accepted; APE rmse %.4f m\n", r.stats.queries,
-              r.stats.verified, r.stats.accepted, r.ape);
+  std::printf("overlap: %zu queries, %zu verified, %zu accepted; APE rmse %.4f m\n", r.stats.queries, r.stats.verified,
+              r.stats.accepted, r.ape);
   EXPECT_GE(r.stats.accepted, 3u);
   for (const LoopEvent& e : r.events) {
     if (!e.verification.accepted) continue;

@@ -28,7 +28,8 @@ OdometryConfig kittiConfig() {
 
 Eigen::Isometry3d trueLidarPose(const std::filesystem::path& dir, int frame) {
   const Eigen::Isometry3d Tr = io::KittiCalibFile((dir / "calib.txt").string()).rigid34("Tr");
-  return Tr.inverse() * io::readKitti((dir / "poses.txt").string()).at(static_cast<std::size_t>(frame)).T_world_body * Tr;
+  return Tr.inverse() * io::readKitti((dir / "poses.txt").string()).at(static_cast<std::size_t>(frame)).T_world_body *
+         Tr;
 }
 
 double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
@@ -40,11 +41,12 @@ TEST(ScanPairKitti, RevisitIsTheSamePlaceAndScanMatchingRecoversTheTruePose) {
                                         io::readKittiBin((dir / "001500.bin").string(), 0, 0), kittiConfig());
   const Eigen::Isometry3d T_true = trueLidarPose(dir, 720).inverse() * trueLidarPose(dir, 1500);
   const Eigen::Isometry3d& T = r.icp.T_candidate_query;
-  std::printf("revisit_08: distance %.4f (plain %.4f), yaw %.1f deg (true %.2f); scan match %s, t = (%.2f, %.2f, "
-              "%.2f) m (true (%.2f, %.2f, %.2f)), yaw %.2f deg\n",
-              r.match.match.distance, r.plain.distance, r.match.match.yaw * kDeg, yawOf(T_true.linear()) * kDeg,
-              r.icp.reason.c_str(), T.translation().x(), T.translation().y(), T.translation().z(),
-              T_true.translation().x(), T_true.translation().y(), T_true.translation().z(), yawOf(T.linear()) * kDeg);
+  std::printf(
+      "revisit_08: distance %.4f (plain %.4f), yaw %.1f deg (true %.2f); scan match %s, t = (%.2f, %.2f, "
+      "%.2f) m (true (%.2f, %.2f, %.2f)), yaw %.2f deg\n",
+      r.match.match.distance, r.plain.distance, r.match.match.yaw * kDeg, yawOf(T_true.linear()) * kDeg,
+      r.icp.reason.c_str(), T.translation().x(), T.translation().y(), T.translation().z(), T_true.translation().x(),
+      T_true.translation().y(), T_true.translation().z(), yawOf(T.linear()) * kDeg);
   EXPECT_TRUE(r.same_place);
   EXPECT_LT(std::abs(std::remainder(r.match.match.yaw - yawOf(T_true.linear()), 2 * std::numbers::pi)) * kDeg, 6.0);
   ASSERT_TRUE(r.icp.accepted) << r.icp.reason;

@@ -1,7 +1,7 @@
 #pragma once
 // A synthetic place with exact geometry for loop-closure tests: LOAM-like features of a walled courtyard (ground
-// and four walls of different heights as plane points, five poles as edge points), in its own world frame, and what a lidar at a given
-// pose sees of it (every point, no occlusion).
+// and four walls of different heights as plane points, five poles as edge points), in its own world frame, and what a
+// lidar at a given pose sees of it (every point, no occlusion).
 #include <Eigen/Geometry>
 #include <random>
 
