@@ -70,6 +70,7 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
       nms_radius: 3
       border: 6
       threads: 2
+      min_keypoints: 40
 )");
   const visual::DetectorConfig& d = c.detector;
   EXPECT_EQ(d.type, DetectorType::kOrb);
@@ -90,6 +91,7 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_EQ(d.superpoint.post.nms_radius, 3);
   EXPECT_EQ(d.superpoint.post.border, 6);
   EXPECT_EQ(d.superpoint.threads, 2);
+  EXPECT_EQ(d.superpoint.post.min_keypoints, 40);
 }
 
 TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {
@@ -189,6 +191,7 @@ TEST(VisualConfigReader, ShippedConfigsGiveTheTrackerAndDepthDefaults) {
     EXPECT_DOUBLE_EQ(c.tracker.forward_backward_px, t.forward_backward_px);
     EXPECT_EQ(c.tracker.clahe, t.clahe);
     EXPECT_DOUBLE_EQ(c.tracker.dark_mean, t.dark_mean);
+    EXPECT_EQ(c.detector.superpoint.post.min_keypoints, 0) << "the floor is off (bench/RESULTS.md)";
     EXPECT_DOUBLE_EQ(c.depth.min_depth, visual::DepthAssociationConfig{}.min_depth);
     EXPECT_DOUBLE_EQ(c.depth.max_depth_spread, visual::DepthAssociationConfig{}.max_depth_spread);
   }
