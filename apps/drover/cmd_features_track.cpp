@@ -139,7 +139,8 @@ void registerFeaturesTrack(CLI::App& features) {
       ->check(CLI::IsMember({"kitti", "kitti-raw", "euroc", "bag", "sim"}));
   cmd->add_option("--config", o->config,
                   "Platform config (config/*.yaml): topics, calibration, visual.detector and visual.tracker");
-  cmd->add_option("--detector", o->detector, "Keypoint detector for new features (default: the config's, else superpoint)")
+  cmd->add_option("--detector", o->detector,
+                  "Keypoint detector for new features (default: the config's, else superpoint)")
       ->check(CLI::IsMember({"superpoint", "shi-tomasi", "orb"}));
   cmd->add_option("--weights", o->weights, "SuperPoint ONNX file (default ../shared/models/superpoint_v1.onnx)");
   cmd->add_option("--out", o->out, "Output folder: tracks.json and overlay_NNNNNN.png")->required();
@@ -147,7 +148,8 @@ void registerFeaturesTrack(CLI::App& features) {
   cmd->add_option("--max-frames", o->max_frames, "Track at most N frames (0 = all)");
   cmd->add_option("--start", o->start, "Skip the first S seconds of camera frames");
   cmd->add_option("--duration", o->duration, "Track S seconds after --start (0 = to the end)");
-  cmd->add_flag("--async", o->async, "Run the detector in a worker thread (results then depend on timing; overrides the config)");
+  cmd->add_flag("--async", o->async,
+                "Run the detector in a worker thread (results then depend on timing; overrides the config)");
   cmd->add_flag("-q,--quiet", o->quiet, "Print only errors");
   cmd->callback([o] { runTrack(*o); });
 }

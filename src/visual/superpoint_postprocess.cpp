@@ -44,8 +44,8 @@ SuperPointPostprocessor::SuperPointPostprocessor(const SuperPointPostConfig& con
   if (std::string err = config_.validate(); !err.empty()) throw std::invalid_argument(err);
 }
 
-// Steps 1-3: the softmax is taken plane by plane (vectorised by OpenCV), with the per-cell maximum subtracted for
-// numerical safety; only pixels at or above the threshold become candidates.
+// Steps 1-2: the softmax is taken plane by plane (vectorised by OpenCV), with the per-cell maximum subtracted for
+// numerical safety. Step 3 (collectCandidates): only unmasked pixels at or above `thr` become candidates.
 void SuperPointPostprocessor::softmax(const cv::Mat& semi) {
   const int hc = semi.size[2], wc = semi.size[3];
   plane(semi, 0).copyTo(max_logit_);
@@ -150,11 +150,11 @@ Keypoints SuperPointPostprocessor::run(const cv::Mat& semi, const cv::Mat& desc,
   softmax(semi);
   collectCandidates(hc, wc, static_cast<float>(config_.confidence_threshold), mask);
   suppress(width, height);
-  const std::size_t floor = static_cast<std::size_t>(std::min(config_.min_keypoints, max_count));
-  if (kept_.size() < floor) {  // step 5's floor: every unmasked pixel is a candidate
+  const std::size_t at_least = static_cast<std::size_t>(std::min(config_.min_keypoints, max_count));
+  if (kept_.size() < at_least) {  // step 5's floor: every unmasked pixel is a candidate
     collectCandidates(hc, wc, 0.0f, mask);
     suppress(width, height);
-    if (kept_.size() > floor) kept_.resize(floor);  // the above-threshold survivors come first and all stay
+    if (kept_.size() > at_least) kept_.resize(at_least);  // the above-threshold survivors come first and all stay
   }
   Keypoints out;
   const std::size_t n = std::min(kept_.size(), static_cast<std::size_t>(max_count));
