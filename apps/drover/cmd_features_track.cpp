@@ -13,6 +13,7 @@
 #include "io/dataset.hpp"
 #include "io/image_file_io.hpp"
 #include "io/trajectory_io.hpp"
+#include "io/visual/visual_config_io.hpp"
 #include "visual/detector_factory.hpp"
 #include "visual/tracking_summary.hpp"
 
@@ -23,7 +24,7 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 struct TrackOptions {
-  std::string dataset, format, config, detector = "superpoint", out, weights;
+  std::string dataset, format, config, detector, out, weights;  // detector "" = the config's (else superpoint)
   int overlay_every = 0;
   int max_frames = 0;
   double start = 0, duration = 0;  // [s] from the first camera frame; duration 0 = to the end
@@ -78,11 +79,13 @@ void runTrack(const TrackOptions& o) {
   options.load_images = true;
   if (o.max_frames > 0 && o.format == "kitti") options.kitti_max_frames = static_cast<std::size_t>(o.max_frames);
   const std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, options);
-  visual::DetectorConfig detector_config;
-  detector_config.type = visual::parseDetectorType(o.detector);
+  // The config's visual.detector and visual.tracker sections, then the flags on top.
+  const io::VisualConfig visual_config = o.config.empty() ? io::VisualConfig{} : io::loadVisualConfig(o.config);
+  visual::DetectorConfig detector_config = visual_config.detector;
+  if (!o.detector.empty()) detector_config.type = visual::parseDetectorType(o.detector);
   if (!o.weights.empty()) detector_config.superpoint.weights = o.weights;
-  visual::FeatureTrackerConfig tracker_config;
-  tracker_config.async_detection = o.async;
+  visual::FeatureTrackerConfig tracker_config = visual_config.tracker;
+  if (o.async) tracker_config.async_detection = true;
   const visual::CameraModel camera(reader->calibration().camera);
   visual::FeatureTracker tracker(camera, visual::makeDetector(detector_config), tracker_config);
 
@@ -109,8 +112,13 @@ void runTrack(const TrackOptions& o) {
   }
   if (index == 0) throw std::runtime_error(o.dataset + ": no camera frames (in the --start/--duration window)");
   const visual::TrackingSummary s = summary.summary();
-  const Json j{{"dataset", o.dataset}, {"format", o.format},        {"detector", o.detector},
-               {"async", o.async},     {"summary", summaryJson(s)}, {"frames", frames}};
+  const Json j{{"dataset", o.dataset},
+               {"format", o.format},
+               {"detector", visual::detectorTypeName(detector_config.type)},
+               {"async", tracker_config.async_detection},
+               {"max_features", tracker_config.max_features},
+               {"summary", summaryJson(s)},
+               {"frames", frames}};
   io::writeFileAtomically((std::filesystem::path(o.out) / "tracks.json").string(), j.dump(1) + "\n");
   if (!o.quiet)
     fmt::print(
@@ -129,8 +137,10 @@ void registerFeaturesTrack(CLI::App& features) {
   cmd->add_option("--format", o->format, "Dataset format")
       ->required()
       ->check(CLI::IsMember({"kitti", "kitti-raw", "euroc", "bag", "sim"}));
-  cmd->add_option("--config", o->config, "Platform config (config/*.yaml): topics, sensors to load, calibration");
-  cmd->add_option("--detector", o->detector, "Keypoint detector for new features")
+  cmd->add_option("--config", o->config,
+                  "Platform config (config/*.yaml): topics, calibration, visual.detector and visual.tracker");
+  cmd->add_option("--detector", o->detector,
+                  "Keypoint detector for new features (default: the config's, else superpoint)")
       ->check(CLI::IsMember({"superpoint", "shi-tomasi", "orb"}));
   cmd->add_option("--weights", o->weights, "SuperPoint ONNX file (default ../shared/models/superpoint_v1.onnx)");
   cmd->add_option("--out", o->out, "Output folder: tracks.json and overlay_NNNNNN.png")->required();
@@ -138,7 +148,8 @@ void registerFeaturesTrack(CLI::App& features) {
   cmd->add_option("--max-frames", o->max_frames, "Track at most N frames (0 = all)");
   cmd->add_option("--start", o->start, "Skip the first S seconds of camera frames");
   cmd->add_option("--duration", o->duration, "Track S seconds after --start (0 = to the end)");
-  cmd->add_flag("--async", o->async, "Run the detector in a worker thread (results then depend on timing)");
+  cmd->add_flag("--async", o->async,
+                "Run the detector in a worker thread (results then depend on timing; overrides the config)");
   cmd->add_flag("-q,--quiet", o->quiet, "Print only errors");
   cmd->callback([o] { runTrack(*o); });
 }

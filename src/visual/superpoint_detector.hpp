@@ -35,7 +35,8 @@ class SuperPointDetector : public KeypointDetector {
   // Loads and checks the network: a missing or malformed file, or outputs without the expected names and shapes
   // (probed by one forward pass on a small image), throw std::invalid_argument with kSuperPointWeightsHelp.
   explicit SuperPointDetector(const SuperPointConfig& config);
-  // Scores are keypoint probabilities in (threshold, 1]; descriptors CV_32F, 256 per row, unit L2 norm.
+  // Scores are keypoint probabilities in [threshold, 1] (below it only for the post.min_keypoints floor);
+  // descriptors CV_32F, 256 per row, unit L2 norm.
   Keypoints detect(const cv::Mat& image, const cv::Mat& mask, int max_count) override;
   std::string name() const override { return "superpoint"; }
   const SuperPointConfig& config() const { return config_; }

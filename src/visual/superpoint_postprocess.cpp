@@ -36,6 +36,7 @@ std::string SuperPointPostConfig::validate() const {
     return "superpoint.confidence_threshold must be in (0, 1), got " + std::to_string(confidence_threshold);
   if (nms_radius < 0) return "superpoint.nms_radius must be >= 0 px, got " + std::to_string(nms_radius);
   if (border < 0) return "superpoint.border must be >= 0 px, got " + std::to_string(border);
+  if (min_keypoints < 0) return "superpoint.min_keypoints must be >= 0, got " + std::to_string(min_keypoints);
   return {};
 }
 
@@ -43,9 +44,9 @@ SuperPointPostprocessor::SuperPointPostprocessor(const SuperPointPostConfig& con
   if (std::string err = config_.validate(); !err.empty()) throw std::invalid_argument(err);
 }
 
-// Steps 1-3: the softmax is taken plane by plane (vectorised by OpenCV), with the per-cell maximum subtracted for
-// numerical safety; only pixels at or above the threshold become candidates.
-void SuperPointPostprocessor::softmaxCandidates(const cv::Mat& semi, const cv::Mat& mask) {
+// Steps 1-2: the softmax is taken plane by plane (vectorised by OpenCV), with the per-cell maximum subtracted for
+// numerical safety. Step 3 (collectCandidates): only unmasked pixels at or above `thr` become candidates.
+void SuperPointPostprocessor::softmax(const cv::Mat& semi) {
   const int hc = semi.size[2], wc = semi.size[3];
   plane(semi, 0).copyTo(max_logit_);
   for (int c = 1; c < kDetChannels; ++c) cv::max(max_logit_, plane(semi, c), max_logit_);
@@ -58,7 +59,9 @@ void SuperPointPostprocessor::softmaxCandidates(const cv::Mat& semi, const cv::M
     cv::exp(tmp_, e);
     sum_exp_ += e;
   }
-  const float thr = static_cast<float>(config_.confidence_threshold);
+}
+
+void SuperPointPostprocessor::collectCandidates(int hc, int wc, float thr, const cv::Mat& mask) {
   candidates_.clear();
   for (int c = 0; c < kDetChannels - 1; ++c) {
     const int dx = c % kCell, dy = c / kCell;
@@ -144,8 +147,15 @@ Keypoints SuperPointPostprocessor::run(const cv::Mat& semi, const cv::Mat& desc,
     throw std::invalid_argument("superpoint: post-processing mask must be CV_8UC1 " + std::to_string(width) + "x" +
                                 std::to_string(height) + ", got " + matTypeName(mask.type()) + " " +
                                 std::to_string(mask.cols) + "x" + std::to_string(mask.rows));
-  softmaxCandidates(semi, mask);
+  softmax(semi);
+  collectCandidates(hc, wc, static_cast<float>(config_.confidence_threshold), mask);
   suppress(width, height);
+  const std::size_t at_least = static_cast<std::size_t>(std::min(config_.min_keypoints, max_count));
+  if (kept_.size() < at_least) {  // step 5's floor: every unmasked pixel is a candidate
+    collectCandidates(hc, wc, 0.0f, mask);
+    suppress(width, height);
+    if (kept_.size() > at_least) kept_.resize(at_least);  // the above-threshold survivors come first and all stay
+  }
   Keypoints out;
   const std::size_t n = std::min(kept_.size(), static_cast<std::size_t>(max_count));
   out.points.reserve(n);

@@ -7,6 +7,10 @@
 //   3. pixels with probability >= confidence_threshold and allowed by the mask are candidates;
 //   4. grid NMS: strongest first, a candidate survives if no survivor lies within nms_radius (Chebyshev, px);
 //   5. survivors closer than `border` px to the image edge are dropped; the strongest max_count are kept;
+//      (Drover's floor, off by default: when fewer than min(min_keypoints, max_count) survive, steps 3-5 are run
+//      again on every unmasked pixel, and the strongest fill up to that many: the absolute threshold, made for
+//      well-exposed images, otherwise leaves a dark frame nearly empty. Points above the threshold are the same
+//      either way, since NMS visits them first.)
 //   6. descriptors: the coarse 256-d map is L2-normalised per cell (as SuperPointNet.forward), sampled bilinearly
 //      at the keypoint, the cell centre of cell (cx, cy) being pixel (8 cx + 3.5, 8 cy + 3.5), clamped to the
 //      outer cell centres, and L2-normalised again.
@@ -23,6 +27,7 @@ struct SuperPointPostConfig {
   double confidence_threshold = 0.015;  // keypoint probability threshold (paper/demo: 0.015)
   int nms_radius = 4;                   // [network px] NMS half-window (demo: 4)
   int border = 4;                       // [network px] keypoints this close to the edge are dropped (demo: 4)
+  int min_keypoints = 0;                // floor (see step 5): below-threshold points fill up to this many; 0 = off
   std::string validate() const;         // empty = valid
 };
 
@@ -40,7 +45,8 @@ class SuperPointPostprocessor {
     float score;
     int x, y;
   };
-  void softmaxCandidates(const cv::Mat& semi, const cv::Mat& mask);
+  void softmax(const cv::Mat& semi);
+  void collectCandidates(int hc, int wc, float threshold, const cv::Mat& mask);
   void suppress(int width, int height);
   void sampleDescriptors(const cv::Mat& desc, Keypoints& out);
 

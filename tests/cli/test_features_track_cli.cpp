@@ -1,6 +1,10 @@
 // `drover features track` end to end on the shared EuRoC snippet: files, keys, figures in sane bounds, errors.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <fstream>
+#include <iterator>
+
 #include "support/cli.hpp"
 #include "support/shared_data.hpp"
 #include "support/temp_dir.hpp"
@@ -64,6 +68,29 @@ TEST(FeaturesTrackCli, AsyncModeRunsAndRecordsIt) {
   const auto j = readJson(dir.path() / "tracks.json");
   EXPECT_EQ(j["async"], true);
   EXPECT_GT(j["summary"]["mean_features"].get<double>(), 50.0);
+}
+
+TEST(FeaturesTrackCli, TheConfigsTrackerSectionReachesTheTracker) {
+  DROVER_REQUIRE_SHARED(kEuroc);
+  TempDir dir;
+  // The shipped EuRoC config with the tracker's cap lowered to 40 (and everything else as shipped).
+  std::ifstream in(std::string(DROVER_SOURCE_DIR) + "/config/euroc.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string key = "    max_features: 150";
+  const auto at = text.find(key);
+  ASSERT_NE(at, std::string::npos) << "config/euroc.yaml has no visual.tracker.max_features line";
+  text.replace(at, key.size(), "    max_features: 40");
+  const fs::path config = dir.path() / "euroc40.yaml";
+  writeText(config, text);
+  const CliResult r = runDrover("features track " + kEuroc.string() + " --format euroc --config " + config.string() +
+                                " --detector shi-tomasi --max-frames 20 -q --out " + (dir.path() / "o").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = readJson(dir.path() / "o" / "tracks.json");
+  EXPECT_EQ(j["max_features"], 40);
+  ASSERT_EQ(j["frames"].size(), 20u);
+  int most = 0;
+  for (const auto& f : j["frames"]) most = std::max(most, f["features"].get<int>());
+  EXPECT_EQ(most, 40) << "the cap is reached and never exceeded (the default would give ~150)";
 }
 
 TEST(FeaturesTrackCli, BadInputIsOneErrorLineAndExitCode2) {

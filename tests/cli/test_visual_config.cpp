@@ -70,6 +70,7 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
       nms_radius: 3
       border: 6
       threads: 2
+      min_keypoints: 40
 )");
   const visual::DetectorConfig& d = c.detector;
   EXPECT_EQ(d.type, DetectorType::kOrb);
@@ -90,6 +91,7 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_EQ(d.superpoint.post.nms_radius, 3);
   EXPECT_EQ(d.superpoint.post.border, 6);
   EXPECT_EQ(d.superpoint.threads, 2);
+  EXPECT_EQ(d.superpoint.post.min_keypoints, 40);
 }
 
 TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {
@@ -122,6 +124,101 @@ TEST(VisualConfigReader, ValuesThatFailValidationNameTheSectionAndItsLine) {
   e = errorOf(dir, "visual:\n  detector:\n    orb: {scale_factor: 0.9}\n");
   EXPECT_TRUE(has(e, "line 3")) << e;
   EXPECT_TRUE(has(e, "scale_factor")) << e;
+}
+
+TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
+  test::TempDir dir;
+  const VisualConfig c = load(dir, R"(visual:
+  tracker:
+    max_features: 40
+    min_distance: 12.5
+    flow_window: 15
+    flow_levels: 2
+    flow_iterations: 20
+    flow_epsilon: 0.02
+    forward_backward: false
+    forward_backward_px: 0.75
+    border_px: 3
+    ransac: false
+    ransac_threshold_px: 1.5
+    ransac_confidence: 0.95
+    virtual_focal_px: 400
+    clahe: always
+    clahe_clip: 2.5
+    clahe_tiles: 4
+    dark_mean: 50
+    async_detection: true
+  depth: {window_s: 3, voxel_size: 0.1, grid_resolution_deg: 1, neighbour_cells: 4, max_depth_spread: 1.5,
+          min_depth: 3, max_depth: 80, min_incidence_cos: 0.1}
+)");
+  const visual::FeatureTrackerConfig& t = c.tracker;
+  EXPECT_EQ(t.max_features, 40);
+  EXPECT_DOUBLE_EQ(t.min_distance, 12.5);
+  EXPECT_EQ(t.flow_window, 15);
+  EXPECT_EQ(t.flow_levels, 2);
+  EXPECT_EQ(t.flow_iterations, 20);
+  EXPECT_DOUBLE_EQ(t.flow_epsilon, 0.02);
+  EXPECT_FALSE(t.forward_backward);
+  EXPECT_DOUBLE_EQ(t.forward_backward_px, 0.75);
+  EXPECT_EQ(t.border_px, 3);
+  EXPECT_FALSE(t.ransac);
+  EXPECT_DOUBLE_EQ(t.ransac_threshold_px, 1.5);
+  EXPECT_DOUBLE_EQ(t.ransac_confidence, 0.95);
+  EXPECT_DOUBLE_EQ(t.virtual_focal_px, 400);
+  EXPECT_EQ(t.clahe, visual::ClaheMode::kAlways);
+  EXPECT_DOUBLE_EQ(t.clahe_clip, 2.5);
+  EXPECT_EQ(t.clahe_tiles, 4);
+  EXPECT_DOUBLE_EQ(t.dark_mean, 50);
+  EXPECT_TRUE(t.async_detection);
+  const visual::DepthAssociationConfig& d = c.depth;
+  EXPECT_DOUBLE_EQ(d.window_s, 3);
+  EXPECT_DOUBLE_EQ(d.voxel_size, 0.1);
+  EXPECT_DOUBLE_EQ(d.grid_resolution_deg, 1);
+  EXPECT_DOUBLE_EQ(d.neighbour_cells, 4);
+  EXPECT_DOUBLE_EQ(d.max_depth_spread, 1.5);
+  EXPECT_DOUBLE_EQ(d.min_depth, 3);
+  EXPECT_DOUBLE_EQ(d.max_depth, 80);
+  EXPECT_DOUBLE_EQ(d.min_incidence_cos, 0.1);
+  EXPECT_EQ(load(dir, "visual:\n  tracker: {clahe: 'off'}\n").tracker.clahe, visual::ClaheMode::kOff);
+}
+
+TEST(VisualConfigReader, ShippedConfigsGiveTheTrackerAndDepthDefaults) {
+  for (const char* name : {"kitti.yaml", "euroc.yaml", "farm_sim.yaml"}) {
+    SCOPED_TRACE(name);
+    const VisualConfig c = loadVisualConfig(shipped(name));
+    const visual::FeatureTrackerConfig t;
+    EXPECT_EQ(c.tracker.max_features, t.max_features);
+    EXPECT_DOUBLE_EQ(c.tracker.forward_backward_px, t.forward_backward_px);
+    EXPECT_EQ(c.tracker.clahe, t.clahe);
+    EXPECT_DOUBLE_EQ(c.tracker.dark_mean, t.dark_mean);
+    EXPECT_EQ(c.detector.superpoint.post.min_keypoints, 0) << "the floor is off (bench/RESULTS.md)";
+    EXPECT_DOUBLE_EQ(c.depth.min_depth, visual::DepthAssociationConfig{}.min_depth);
+    EXPECT_DOUBLE_EQ(c.depth.max_depth_spread, visual::DepthAssociationConfig{}.max_depth_spread);
+  }
+}
+
+TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
+  test::TempDir dir;
+  std::string e = errorOf(dir, "visual:\n  tracker:\n    max_features: 100\n    max_feature: 40\n");
+  EXPECT_TRUE(has(e, "visual.yaml")) << e;
+  EXPECT_TRUE(has(e, "line 4")) << e;
+  EXPECT_TRUE(has(e, "visual.tracker.max_feature")) << e;
+  e = errorOf(dir, "visual:\n  depth:\n    window: 5\n");
+  EXPECT_TRUE(has(e, "line 3")) << e;
+  EXPECT_TRUE(has(e, "visual.depth.window")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    forward_backward_px: wide\n");
+  EXPECT_TRUE(has(e, "line 3")) << e;
+  EXPECT_TRUE(has(e, "visual.tracker.forward_backward_px")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    clahe: sometimes\n");
+  EXPECT_TRUE(has(e, "line 3")) << e;
+  EXPECT_TRUE(has(e, "off, always or when_dark")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    flow_window: 20\n");  // parses, fails validate()
+  EXPECT_TRUE(has(e, "line 3")) << e;
+  EXPECT_TRUE(has(e, "visual.tracker")) << e;
+  EXPECT_TRUE(has(e, "flow_window must be odd")) << e;
+  e = errorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
+  EXPECT_TRUE(has(e, "visual.depth")) << e;
+  EXPECT_TRUE(has(e, "line 3")) << e;
 }
 
 TEST(VisualConfigReader, MissingFileIsAnIoError) {

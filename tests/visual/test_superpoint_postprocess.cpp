@@ -90,6 +90,36 @@ TEST(SuperPointPostprocess, ProbabilitiesBelowTheThresholdAreNotKeypoints) {
   EXPECT_TRUE(run(semi, cv::Mat(), strict).points.empty());
 }
 
+TEST(SuperPointPostprocess, TheMinKeypointsFloorFillsWithTheStrongestBelowThreshold) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 20, 20, 0.5);    // above 0.015
+  setProbability(semi, 40, 20, 0.010);  // below: the two strongest weak peaks
+  setProbability(semi, 20, 35, 0.008);
+  setProbability(semi, 40, 35, 0.004);
+  SuperPointPostConfig cfg;
+  EXPECT_EQ(run(semi, cv::Mat(), cfg).points.size(), 1u) << "off by default: only the peak above threshold";
+  cfg.min_keypoints = 3;
+  Keypoints k = run(semi, cv::Mat(), cfg);
+  ASSERT_EQ(k.points.size(), 3u) << "filled up to the floor, not beyond";
+  EXPECT_EQ(k.points[0], cv::Point2f(20, 20));
+  EXPECT_EQ(k.points[1], cv::Point2f(40, 20));
+  EXPECT_EQ(k.points[2], cv::Point2f(20, 35));
+  EXPECT_NEAR(k.scores[2], 0.008, 1e-6);
+  cv::Mat mask(48, 64, CV_8UC1, cv::Scalar(255));
+  mask(cv::Rect(36, 16, 8, 8)).setTo(0);  // hides (40, 20): the floor respects the mask
+  k = run(semi, mask, cfg);
+  ASSERT_EQ(k.points.size(), 3u);
+  EXPECT_EQ(k.points[1], cv::Point2f(20, 35));
+  EXPECT_EQ(k.points[2], cv::Point2f(40, 35));
+  cfg.min_keypoints = 1;  // met by the threshold alone: nothing weak is added
+  EXPECT_EQ(run(semi, cv::Mat(), cfg).points.size(), 1u);
+  cfg.min_keypoints = 3;
+  SuperPointPostprocessor post(cfg);
+  EXPECT_EQ(post.run(semi, cv::Mat(), cv::Mat(), 2).points.size(), 2u) << "the floor never exceeds max_count";
+  cfg.min_keypoints = -1;
+  EXPECT_NE(cfg.validate(), "");
+}
+
 TEST(SuperPointPostprocess, MaskedCandidatesAreDroppedBeforeNms) {
   cv::Mat semi = emptySemi();
   setProbability(semi, 20, 20, 0.9);

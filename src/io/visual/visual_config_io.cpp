@@ -35,6 +35,7 @@ void bindSuperPoint(YamlSection& s, visual::SuperPointConfig& c) {
       .bind("confidence_threshold", c.post.confidence_threshold)
       .bind("nms_radius", c.post.nms_radius)
       .bind("border", c.post.border)
+      .bind("min_keypoints", c.post.min_keypoints)
       .bind("threads", c.threads);
 }
 
@@ -43,6 +44,56 @@ void bindDetector(YamlSection& s, visual::DetectorConfig& c, std::string& type) 
       .nested("shi_tomasi", [&](YamlSection& n) { bindShiTomasi(n, c.shi_tomasi); })
       .nested("orb", [&](YamlSection& n) { bindOrb(n, c.orb); })
       .nested("superpoint", [&](YamlSection& n) { bindSuperPoint(n, c.superpoint); });
+}
+
+void bindTracker(YamlSection& s, visual::FeatureTrackerConfig& c, std::string& clahe) {
+  s.bind("max_features", c.max_features)
+      .bind("min_distance", c.min_distance)
+      .bind("flow_window", c.flow_window)
+      .bind("flow_levels", c.flow_levels)
+      .bind("flow_iterations", c.flow_iterations)
+      .bind("flow_epsilon", c.flow_epsilon)
+      .bind("forward_backward", c.forward_backward)
+      .bind("forward_backward_px", c.forward_backward_px)
+      .bind("border_px", c.border_px)
+      .bind("ransac", c.ransac)
+      .bind("ransac_threshold_px", c.ransac_threshold_px)
+      .bind("ransac_confidence", c.ransac_confidence)
+      .bind("virtual_focal_px", c.virtual_focal_px)
+      .bindChoice("clahe", clahe, {"off", "always", "when_dark"})
+      .bind("clahe_clip", c.clahe_clip)
+      .bind("clahe_tiles", c.clahe_tiles)
+      .bind("dark_mean", c.dark_mean)
+      .bind("async_detection", c.async_detection);
+}
+
+void bindDepth(YamlSection& s, visual::DepthAssociationConfig& c) {
+  s.bind("window_s", c.window_s)
+      .bind("voxel_size", c.voxel_size)
+      .bind("grid_resolution_deg", c.grid_resolution_deg)
+      .bind("neighbour_cells", c.neighbour_cells)
+      .bind("max_depth_spread", c.max_depth_spread)
+      .bind("min_depth", c.min_depth)
+      .bind("max_depth", c.max_depth)
+      .bind("min_incidence_cos", c.min_incidence_cos);
+}
+
+const char* claheName(visual::ClaheMode m) {
+  switch (m) {
+    case visual::ClaheMode::kOff:
+      return "off";
+    case visual::ClaheMode::kAlways:
+      return "always";
+    case visual::ClaheMode::kWhenDark:
+      break;
+  }
+  return "when_dark";
+}
+
+visual::ClaheMode parseClahe(const std::string& name) {  // already checked by bindChoice
+  if (name == "off") return visual::ClaheMode::kOff;
+  if (name == "always") return visual::ClaheMode::kAlways;
+  return visual::ClaheMode::kWhenDark;
 }
 
 // A Config::validate() message, with the line of the sub-section it concerns when the file has one.
@@ -69,17 +120,24 @@ VisualConfig loadVisualConfig(const std::string& yaml_path) {
   if (root.IsNull()) return c;
   if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
   std::string type = visual::detectorTypeName(c.detector.type);
+  std::string clahe = claheName(c.tracker.clahe);
   YamlSection top(yaml_path, "visual");
-  top.nested("detector", [&](YamlSection& s) { bindDetector(s, c.detector, type); });
+  top.nested("detector", [&](YamlSection& s) { bindDetector(s, c.detector, type); })
+      .nested("tracker", [&](YamlSection& s) { bindTracker(s, c.tracker, clahe); })
+      .nested("depth", [&](YamlSection& s) { bindDepth(s, c.depth); });
   const YAML::Node visual = root["visual"];
   top.apply(visual);
   c.detector.type = visual::parseDetectorType(type);  // already checked by bindChoice
+  c.tracker.clahe = parseClahe(clahe);
   // Every detector's settings are checked, not only the chosen one's: a typo must not wait for a switch.
   const YAML::Node det = visual && visual.IsMap() ? visual["detector"] : YAML::Node();
   auto sub = [&](const char* key) { return det && det.IsMap() ? det[key] : YAML::Node(); };
   checkValid(yaml_path, sub("shi_tomasi"), "visual.detector.shi_tomasi", c.detector.shi_tomasi.validate());
   checkValid(yaml_path, sub("orb"), "visual.detector.orb", c.detector.orb.validate());
   checkValid(yaml_path, sub("superpoint"), "visual.detector.superpoint", c.detector.superpoint.validate());
+  auto section = [&](const char* key) { return visual && visual.IsMap() ? visual[key] : YAML::Node(); };
+  checkValid(yaml_path, section("tracker"), "visual.tracker", c.tracker.validate());
+  checkValid(yaml_path, section("depth"), "visual.depth", c.depth.validate());
   return c;
 }
 

@@ -7,18 +7,30 @@
 //       shi_tomasi:   max_cnt, min_dist [px], quality_level, block_size [px]  (visual/shi_tomasi_detector.hpp)
 //       orb:          n_features, scale_factor, n_levels, fast_threshold [grey levels], edge_threshold [px]
 //       superpoint:   weights (ONNX file; relative = to the working directory), input_width, input_height [px],
-//                     max_keypoints, confidence_threshold, nms_radius [px], border [px], threads
-// The tracker and depth association will add `visual.tracker` and `visual.depth` beside `detector`: one bind
-// function per sub-section in visual_config_io.cpp, one field in VisualConfig.
+//                     max_keypoints, confidence_threshold, nms_radius [px], border [px], threads,
+//                     min_keypoints (floor below the threshold; 0 = off)
+//     tracker:        max_features, min_distance [px], flow_window [px], flow_levels, flow_iterations,
+//                     flow_epsilon [px], forward_backward (bool), forward_backward_px [px], border_px [px],
+//                     ransac (bool), ransac_threshold_px [px at virtual_focal_px], ransac_confidence,
+//                     virtual_focal_px [px], clahe (off | always | when_dark), clahe_clip, clahe_tiles,
+//                     dark_mean [grey levels], async_detection (bool)          (visual/feature_tracker.hpp)
+//     depth:          window_s [s], voxel_size [m], grid_resolution_deg [deg], neighbour_cells [cells],
+//                     max_depth_spread [m], min_depth [m], max_depth [m], min_incidence_cos
+//                                                                              (visual/depth_association.hpp)
+// One bind function per sub-section in visual_config_io.cpp, one field in VisualConfig.
 // Lives in its own library (drover_io_visual) so that the readers do not depend on the visual module.
 #include <string>
 
+#include "visual/depth_association.hpp"
 #include "visual/detector_factory.hpp"
+#include "visual/feature_tracker.hpp"
 
 namespace drover::io {
 
 struct VisualConfig {
   visual::DetectorConfig detector;
+  visual::FeatureTrackerConfig tracker;
+  visual::DepthAssociationConfig depth;
 };
 
 // Throws IoError (file, line, key) for a missing file, invalid YAML, unknown key or bad value, and when a
