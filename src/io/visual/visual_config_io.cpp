@@ -109,16 +109,9 @@ void checkValid(const std::string& file, const YAML::Node& node, const std::stri
 }  // namespace
 
 VisualConfig loadVisualConfig(const std::string& yaml_path) {
-  if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
-  YAML::Node root;
-  try {
-    root = YAML::Load(readYamlText(yaml_path));
-  } catch (const YAML::Exception& e) {
-    fail(yaml_path, lineRecord(static_cast<std::size_t>(e.mark.line + 1)), "invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = loadConfigRoot(yaml_path);
   VisualConfig c;
   if (root.IsNull()) return c;
-  if (!root.IsMap()) fail(yaml_path, "", "expected a YAML map of sections at top level");
   std::string type = visual::detectorTypeName(c.detector.type);
   std::string clahe = claheName(c.tracker.clahe);
   YamlSection top(yaml_path, "visual");
