@@ -228,7 +228,7 @@ Eigen::Isometry3d truthAt(const Trajectory& truth, Time t) {
   return Eigen::Isometry3d::Identity();
 }
 
-TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueWithTheTrueRelativePose) {
+TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectoryStaysWithinFiveCentimetres) {
   const OverlapRun& r = overlap();
   std::printf("overlap: %zu queries, %zu verified, %zu accepted; APE rmse %.4f m\n", r.stats.queries, r.stats.verified,
               r.stats.accepted, r.ape);
@@ -242,13 +242,11 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueWithTheTrueRelativ
     EXPECT_LT(Eigen::AngleAxisd(err.linear()).angle() * 180 / kPi, 1.0);
     EXPECT_LT(T_true.translation().norm(), 5.0);
   }
+  // Without loops this course gives 0.016 m (the lidar-inertial odometry alone is good here); the loops must not
+  // spoil it. (One test: ctest runs each test in its own process, and the course takes ~15 s.)
+  EXPECT_LT(r.ape, 0.05);
 }
 
-TEST(LoopClosureSim, TheTrajectoryWithLoopsStaysWithinFiveCentimetresOfTheTruth) {
-  // Without loops this course gives 0.016 m (the lidar-inertial odometry alone is good here); the loops must not
-  // spoil it.
-  EXPECT_LT(overlap().ape, 0.05);
-}
 
 }  // namespace
 }  // namespace drover::pipeline
