@@ -247,6 +247,5 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectorySt
   EXPECT_LT(r.ape, 0.05);
 }
 
-
 }  // namespace
 }  // namespace drover::pipeline
