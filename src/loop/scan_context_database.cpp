@@ -118,14 +118,14 @@ DatabaseQuery ScanContextDatabase::query(const AugmentedScanContext& q,
     c.id = m.ids[entry];
     c.ring_key_distance = std::sqrt(static_cast<double>(r.d2));
     const std::optional<double> prior = yaw_prior ? yaw_prior(c.id) : std::nullopt;
-    AugmentedScanContext positions;  // the real position and the retrieving one
-    for (std::size_t v : {std::size_t{0}, r.position}) {
-      if (v == 0 && !positions.descriptors.empty()) continue;
-      positions.descriptors.push_back(q.descriptors[v]);
-      positions.offsets.push_back(q.offsets.size() > v ? q.offsets[v] : Eigen::Vector2f::Zero());
+    // The real position, and the virtual one that retrieved the entry when that is another; the better is kept.
+    const auto offset = [&](std::size_t v) { return q.offsets.size() > v ? q.offsets[v] : Eigen::Vector2f::Zero(); };
+    const ScanContext& entry_descriptor = m.descriptors[entry];
+    c.match = {narrowedShiftSearch(entry_descriptor, q.descriptors[0], prior, config_.descriptor), 0, offset(0)};
+    if (r.position != 0) {
+      const ShiftMatch v = narrowedShiftSearch(entry_descriptor, q.descriptors[r.position], prior, config_.descriptor);
+      if (v.distance < c.match.match.distance) c.match = {v, static_cast<int>(r.position), offset(r.position)};
     }
-    c.match = augmentedShiftSearch(m.descriptors[entry], positions, prior, config_.descriptor);
-    c.match.index = static_cast<int>(c.match.index == 0 ? 0 : r.position);
     out.shifts_evaluated += c.match.match.evaluated;
     out.candidates.push_back(c);
   }
