@@ -14,6 +14,7 @@
 #include <stdexcept>
 
 #include "apps/drover/loop_eval.hpp"
+#include "geometry/so3.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "loop/scan_context_database.hpp"
@@ -47,8 +48,6 @@ class Truth {
   const Trajectory& poses_;
   Eigen::Isometry3d T_body_lidar_ = Eigen::Isometry3d::Identity();
 };
-
-double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
 
 class CourseEvaluator {
  public:
@@ -117,7 +116,7 @@ class CourseEvaluator {
     }
     // A detected right place: would the prior-narrowed search (ground-truth relative yaw) find the same shift?
     const std::size_t id = static_cast<std::size_t>(best->id);
-    const double yaw = yawOf(poses_[id].linear().transpose() * poses_[index].linear());
+    const double yaw = geometry::yawOf(poses_[id].linear().transpose() * poses_[index].linear());
     const loop::ShiftMatch narrowed = loop::narrowedShiftSearch(
         database_.descriptor(best->id), query.descriptors[static_cast<std::size_t>(best->match.index)], yaw, sc_);
     ++data_.narrowed_checked;

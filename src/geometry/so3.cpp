@@ -74,6 +74,12 @@ Eigen::Quaterniond slerp(const Eigen::Quaterniond& q0, const Eigen::Quaterniond&
 
 double rotationAngle(const Eigen::Matrix3d& R) { return logSO3(R).norm(); }
 
+double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
+
+Eigen::Matrix3d withRollPitchOf(const Eigen::Matrix3d& R_heading, const Eigen::Matrix3d& R_tilt) {
+  return Eigen::AngleAxisd(yawOf(R_heading) - yawOf(R_tilt), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_tilt;
+}
+
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d D = Eigen::Matrix3d::Identity();

@@ -30,6 +30,12 @@ Eigen::Quaterniond slerp(const Eigen::Quaterniond& q0, const Eigen::Quaterniond&
 // Rotation angle of R [rad], in [0, pi].
 double rotationAngle(const Eigen::Matrix3d& R);
 
+// Heading of R [rad]: the yaw of its x axis about the z axis, atan2(R10, R00), in (-pi, pi].
+double yawOf(const Eigen::Matrix3d& R);
+// R_tilt turned about the z axis until its heading is R_heading's: the tilt (roll, pitch) of one rotation with the
+// heading of the other. For ground robots (|pitch| well below 90 deg).
+Eigen::Matrix3d withRollPitchOf(const Eigen::Matrix3d& R_heading, const Eigen::Matrix3d& R_tilt);
+
 // Projects a nearly orthonormal matrix (e.g. parsed from 12 printed numbers) to the closest rotation (SVD).
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& M);
 

@@ -6,6 +6,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "geometry/so3.hpp"
+
 namespace drover::loop {
 namespace {
 
@@ -229,9 +231,9 @@ AugmentedMatch augmentedShiftSearch(const ScanContext& a, const AugmentedScanCon
 
 Eigen::Isometry3d relativePoseFromMatch(const AugmentedMatch& match, const Eigen::Matrix3d& R_tilt) {
   const double yaw = match.match.yaw;
-  const double tilt_yaw = std::atan2(R_tilt(1, 0), R_tilt(0, 0));
+  const Eigen::Matrix3d R_yaw = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::AngleAxisd(yaw - tilt_yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_tilt;
+  T.linear() = geometry::withRollPitchOf(R_yaw, R_tilt);
   const Eigen::Vector3d offset(match.offset.x(), match.offset.y(), 0.0);
   T.translation() = -(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * offset);
   return T;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "geometry/se3.hpp"
+#include "geometry/so3.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "pipeline/motion_models.hpp"
 
@@ -28,12 +29,6 @@ Eigen::Vector3d velocityFrom(const Trajectory& trajectory, const Eigen::Isometry
 }
 
 }  // namespace
-
-Eigen::Matrix3d withRollPitchOf(const Eigen::Matrix3d& R_heading, const Eigen::Matrix3d& R_tilt) {
-  const double yaw_heading = std::atan2(R_heading(1, 0), R_heading(0, 0));
-  const double yaw_tilt = std::atan2(R_tilt(1, 0), R_tilt(0, 0));
-  return Eigen::AngleAxisd(yaw_heading - yaw_tilt, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_tilt;
-}
 
 ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_imu_lidar)
     : config_(config),
@@ -149,7 +144,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     // The lidar left some directions (or all) to the IMU: the fused state is the pose.
     out.T_world_lidar = T_world_lidar_fused;
   } else if (config_.gravity_roll_pitch) {
-    out.T_world_lidar.linear() = withRollPitchOf(out.T_world_lidar.linear(), T_world_lidar_fused.linear());
+    out.T_world_lidar.linear() = geometry::withRollPitchOf(out.T_world_lidar.linear(), T_world_lidar_fused.linear());
   }
 }
 

@@ -19,10 +19,6 @@ namespace drover::pipeline {
 
 struct ScanOutcome;
 
-// R_tilt turned about the world z axis until its heading (the yaw of its x axis) is R_heading's: the tilt (roll,
-// pitch) of one rotation with the heading of the other. For ground robots (|pitch| well below 90 deg).
-Eigen::Matrix3d withRollPitchOf(const Eigen::Matrix3d& R_heading, const Eigen::Matrix3d& R_tilt);
-
 class ImuFusion {
  public:
   // T_imu_lidar: the lidar's pose on the IMU (body).

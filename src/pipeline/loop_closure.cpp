@@ -8,13 +8,13 @@
 #include <optional>
 #include <stdexcept>
 
+#include "geometry/so3.hpp"
+
 namespace drover::pipeline {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
 
 // A candidate before verification: where it came from and the guess of the query in its frame.
 struct Candidate {
@@ -156,7 +156,7 @@ std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map,
         }
       }
       if (!config.yaw_prior) return std::nullopt;
-      return yawOf(map.keyframe(static_cast<std::size_t>(id)).T_world_lidar.linear().transpose() *
+      return geometry::yawOf(map.keyframe(static_cast<std::size_t>(id)).T_world_lidar.linear().transpose() *
                    T_world_query.linear());
     };
     const loop::DatabaseQuery q = database.query(query, prior);

@@ -23,6 +23,27 @@ Eigen::Matrix3d numericalJacobian(F f, const Eigen::Vector3d& x, double h = 1e-6
   }
   return J;
 }
+TEST(SO3, YawOfIsTheHeadingOfTheXAxisWhateverTheTilt) {
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) *
+                             Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()) *
+                             Eigen::AngleAxisd(-0.05, Eigen::Vector3d::UnitX()))
+                                .toRotationMatrix();
+  EXPECT_NEAR(yawOf(R), 0.7, 1e-12);
+  EXPECT_NEAR(yawOf(Eigen::AngleAxisd(-3.0, Eigen::Vector3d::UnitZ()).toRotationMatrix()), -3.0, 1e-12);
+}
+
+TEST(SO3, WithRollPitchOfKeepsOneHeadingAndTheOthersTilt) {
+  const Eigen::Matrix3d tilt = (Eigen::AngleAxisd(-1.2, Eigen::Vector3d::UnitZ()) *
+                                Eigen::AngleAxisd(0.08, Eigen::Vector3d::UnitY()) *
+                                Eigen::AngleAxisd(0.03, Eigen::Vector3d::UnitX()))
+                                   .toRotationMatrix();
+  const Eigen::Matrix3d heading = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d R = withRollPitchOf(heading, tilt);
+  EXPECT_NEAR(yawOf(R), 0.4, 1e-12);
+  // The same tilt: the world z axis seen from the body is unchanged.
+  EXPECT_LT((R.transpose() * Eigen::Vector3d::UnitZ() - tilt.transpose() * Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+}
+
 }  // namespace
 
 TEST(SO3, HatIsTheCrossProductAndVeeInvertsIt) {
