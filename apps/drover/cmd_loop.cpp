@@ -31,12 +31,7 @@ struct PairOptions {
 // Without a config: the KITTI HDL-64E as config/kitti.yaml describes it (the .bin files are KITTI's format).
 pipeline::OdometryConfig pairConfig(const PairOptions& o) {
   if (!o.config.empty()) return io::loadOdometryConfig(o.config);
-  pipeline::OdometryConfig c;
-  c.layout = lidar::ScanLayoutConfig::kittiHdl64();
-  c.features.columns = c.layout.columns;
-  c.features.min_range = static_cast<float>(c.layout.min_range);
-  c.features.max_range = static_cast<float>(c.layout.max_range);
-  return c;
+  return pipeline::OdometryConfig::kittiHdl64();
 }
 
 Json verificationJson(const loop::LoopVerification& v) {

@@ -14,9 +14,8 @@
 #include "apps/drover/loop_eval.hpp"
 #include "io/kitti_common.hpp"
 #include "io/odometry/odometry_config_io.hpp"
-#include "lidar/feature_extractor.hpp"
-#include "lidar/scan_layout.hpp"
 #include "loop/scan_context.hpp"
+#include "pipeline/scan_pair.hpp"
 
 namespace drover::cli {
 namespace {
@@ -63,15 +62,8 @@ double msSince(std::chrono::steady_clock::time_point t0) {
 }  // namespace
 
 pipeline::OdometryConfig loopEvalConfig(const LoopEvalOptions& o) {
-  pipeline::OdometryConfig c;
-  if (!o.config.empty()) {
-    c = io::loadOdometryConfig(o.config);
-  } else {
-    c.layout = lidar::ScanLayoutConfig::kittiHdl64();
-    c.features.columns = c.layout.columns;
-    c.features.min_range = static_cast<float>(c.layout.min_range);
-    c.features.max_range = static_cast<float>(c.layout.max_range);
-  }
+  pipeline::OdometryConfig c =
+      o.config.empty() ? pipeline::OdometryConfig::kittiHdl64() : io::loadOdometryConfig(o.config);
   loop::ScanContextConfig& sc = c.loop.database.descriptor;
   if (o.threshold >= 0) sc.threshold = o.threshold;
   if (o.no_augment) sc.lateral_steps = 0;
@@ -80,13 +72,7 @@ pipeline::OdometryConfig loopEvalConfig(const LoopEvalOptions& o) {
 }
 
 lidar::PointCloud descriptorCloud(LidarScan scan, const pipeline::OdometryConfig& config) {
-  lidar::sanitize(scan, config.layout);
-  if (static_cast<int>(scan.points.size()) < config.min_points)
-    throw std::invalid_argument(fmt::format("scan has {} valid points (fewer than min_points = {})",
-                                            scan.points.size(), config.min_points));
-  if (!scan.has_time) lidar::inferTimes(scan, config.layout);
-  if (!scan.has_ring) lidar::inferRings(scan, config.layout);
-  return lidar::FeatureExtractor(config.features).extract(scan).features.full;
+  return pipeline::prepareScan(scan, config).full;
 }
 
 LoopEvalData evaluatePairs(const LoopEvalOptions& o, const pipeline::OdometryConfig& config) {

@@ -11,6 +11,15 @@ std::string prefixed(const char* component, const std::string& error) {
 
 }  // namespace
 
+OdometryConfig OdometryConfig::kittiHdl64() {
+  OdometryConfig c;
+  c.layout = lidar::ScanLayoutConfig::kittiHdl64();
+  c.features.columns = c.layout.columns;
+  c.features.min_range = static_cast<float>(c.layout.min_range);
+  c.features.max_range = static_cast<float>(c.layout.max_range);
+  return c;
+}
+
 std::string OdometryConfig::validate() const {
   if (deskew_refinements < 0 || deskew_refinements > 10)
     return "deskew_refinements must be in [0, 10], got " + std::to_string(deskew_refinements);

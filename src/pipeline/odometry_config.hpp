@@ -55,6 +55,9 @@ struct OdometryConfig {
   LoopClosureConfig loop;  // the `loop:` section of platform configs (on by default)
   // Empty when valid, else the first problem found, naming the component and value.
   std::string validate() const;
+  // For tools that read KITTI .bin scans without a config file: the HDL-64E as config/kitti.yaml describes it
+  // (layout, and the feature extractor's columns and range limits); everything else default.
+  static OdometryConfig kittiHdl64();
 };
 
 }  // namespace drover::pipeline

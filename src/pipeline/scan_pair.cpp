@@ -8,25 +8,22 @@
 #include "lidar/scan_layout.hpp"
 
 namespace drover::pipeline {
-namespace {
-
-lidar::FeatureSet prepare(LidarScan& scan, const OdometryConfig& config, const char* name, std::size_t& points) {
+lidar::FeatureSet prepareScan(LidarScan& scan, const OdometryConfig& config, const std::string& name) {
   lidar::sanitize(scan, config.layout);
-  points = scan.points.size();
-  if (static_cast<int>(points) < config.min_points)
-    throw std::invalid_argument(
-        fmt::format("scan {} has {} valid points (fewer than min_points = {})", name, points, config.min_points));
+  if (static_cast<int>(scan.points.size()) < config.min_points)
+    throw std::invalid_argument(fmt::format("{} has {} valid points (fewer than min_points = {})", name,
+                                            scan.points.size(), config.min_points));
   if (!scan.has_time) lidar::inferTimes(scan, config.layout);
   if (!scan.has_ring) lidar::inferRings(scan, config.layout);
   return lidar::FeatureExtractor(config.features).extract(scan).features;
 }
 
-}  // namespace
-
 ScanPairResult compareScans(LidarScan a, LidarScan b, const OdometryConfig& config) {
   ScanPairResult r;
-  const lidar::FeatureSet fa = prepare(a, config, "A", r.points_a);
-  const lidar::FeatureSet fb = prepare(b, config, "B", r.points_b);
+  const lidar::FeatureSet fa = prepareScan(a, config, "scan A");
+  const lidar::FeatureSet fb = prepareScan(b, config, "scan B");
+  r.points_a = a.points.size();
+  r.points_b = b.points.size();
   const loop::ScanContextConfig& sc = config.loop.database.descriptor;
   // The descriptors use every valid point, as the reference implementation does with the raw scan.
   lidar::PointCloud ca, cb;

@@ -4,6 +4,8 @@
 // inference when the lidar gives none, LOAM features; no deskew: KITTI's scans are already motion-compensated),
 // A is the database side and B the query (laterally augmented, as in LoopClosure), and B's features are registered
 // to A's from the Scan Context guess by the loop verifier.
+#include <string>
+
 #include "loop/loop_verifier.hpp"
 #include "loop/scan_context.hpp"
 #include "pipeline/odometry_config.hpp"
@@ -20,6 +22,11 @@ struct ScanPairResult {
   Eigen::Isometry3d T_A_B_guess = Eigen::Isometry3d::Identity();  // the Scan Context guess it started from
   std::size_t points_a = 0, points_b = 0;                         // valid points after sanitising
 };
+
+// One scan prepared as the odometry prepares a sweep (no deskew): sanitized in place, ring/time inferred when absent,
+// LOAM features extracted. Throws std::invalid_argument naming the scan (`name`) when fewer than config.min_points
+// valid points remain.
+lidar::FeatureSet prepareScan(LidarScan& scan, const OdometryConfig& config, const std::string& name = "scan");
 
 // Uses config.layout, config.features, config.loop.database.descriptor and config.loop.verifier. Throws
 // std::invalid_argument when a scan has fewer than config.min_points valid points.

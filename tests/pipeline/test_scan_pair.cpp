@@ -17,14 +17,7 @@ namespace {
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
 // The KITTI HDL-64E as config/kitti.yaml describes it (what `drover loop pair` uses without --config).
-OdometryConfig kittiConfig() {
-  OdometryConfig c;
-  c.layout = lidar::ScanLayoutConfig::kittiHdl64();
-  c.features.columns = c.layout.columns;
-  c.features.min_range = static_cast<float>(c.layout.min_range);
-  c.features.max_range = static_cast<float>(c.layout.max_range);
-  return c;
-}
+OdometryConfig kittiConfig() { return OdometryConfig::kittiHdl64(); }
 
 Eigen::Isometry3d trueLidarPose(const std::filesystem::path& dir, int frame) {
   const Eigen::Isometry3d Tr = io::KittiCalibFile((dir / "calib.txt").string()).rigid34("Tr");
