@@ -104,10 +104,12 @@ Json statsJson(const pipeline::OdometryStats& s) {
   return j;
 }
 
-// One compact record per sweep, for diagnosing a run.
+Json vectorJson(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+// One compact record per sweep, for diagnosing a run; with the IMU also the smoother's velocity and biases.
 Json scansJson(const RunRecord& r) {
   Json a = Json::array();
-  for (const pipeline::ScanOutcome& s : r.scans)
+  for (const pipeline::ScanOutcome& s : r.scans) {
     a.push_back({{"t", toSeconds(s.t)},
                  {"status", s.match_status},
                  {"iterations", s.iterations},
@@ -122,6 +124,12 @@ Json scansJson(const RunRecord& r) {
                  {"imu", s.imu_used},
                  {"reset", s.reset},
                  {"total_ms", s.ms.total}});
+    if (s.has_imu_state) {
+      a.back()["v_world"] = vectorJson(s.v_world);           // [m/s]
+      a.back()["gyro_bias"] = vectorJson(s.gyro_bias);       // [rad/s], IMU frame
+      a.back()["acc_bias"] = vectorJson(s.acc_bias);         // [m/s^2], IMU frame
+    }
+  }
   return a;
 }
 

@@ -139,6 +139,10 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     return;
   }
   propagator_.reset(r.state, r.bias);
+  out.has_imu_state = true;
+  out.v_world = r.state.v_world;
+  out.gyro_bias = r.bias.gyro;
+  out.acc_bias = r.bias.acc;
   const Eigen::Isometry3d T_world_lidar_fused = r.state.T_world_imu * T_imu_lidar_;
   if (out.degenerate || !out.match_usable) {
     // The lidar left some directions (or all) to the IMU: the fused state is the pose.

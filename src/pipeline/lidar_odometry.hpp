@@ -48,6 +48,11 @@ struct ScanOutcome {
   int edge_inliers = 0, plane_inliers = 0;
   std::size_t points = 0, edges = 0, planes = 0;  // valid points in, features out
   bool reset = false;             // the smoother diverged and was reset at this sweep
+  // The smoother's newest state after this sweep (IMU mode, when it ran): the IMU's velocity in the world frame
+  // [m/s] and the biases in the IMU frame, gyro [rad/s] and accelerometer [m/s^2].
+  bool has_imu_state = false;
+  Eigen::Vector3d v_world = Eigen::Vector3d::Zero(), gyro_bias = Eigen::Vector3d::Zero(),
+                  acc_bias = Eigen::Vector3d::Zero();
   bool loop_closed = false;       // this sweep's keyframe closed a loop: the trajectory so far was corrected
   std::string warning;            // one line when something was off with this sweep
   std::string note;               // one line of news (a loop closed), not a problem

@@ -204,6 +204,30 @@ TEST_F(SimRun, WithTheImuTheRunIsLidarPlusImuWithOnePosePerSweepInTheImuFrame) {
   // Sweeps of 0.1 s over 4 s.
   EXPECT_NEAR(static_cast<double>(io::readTum((out(true) / "trajectory.tum").string()).size()), 40.0, 1.0);
   expectImuHeightAboveTheMapGround(true);
+  // Every sweep after the first carries the smoother's velocity [m/s] and biases; the last one's speed is the
+  // ground truth's (central difference of its 200 Hz poses) to 5 cm/s (speed: the run picks its own world frame).
+  ASSERT_GT(r["scans"].size(), 30u);
+  EXPECT_FALSE(r["scans"][0].contains("v_world"));
+  for (std::size_t i = 1; i < r["scans"].size(); ++i) {
+    ASSERT_TRUE(r["scans"][i].contains("v_world")) << i;
+    EXPECT_EQ(r["scans"][i]["gyro_bias"].size(), 3u);
+    EXPECT_EQ(r["scans"][i]["acc_bias"].size(), 3u);
+  }
+  const Json& last = r["scans"].back();
+  const Trajectory gt = io::readTum((data() / "groundtruth.txt").string());
+  const Time t = fromSeconds(last["t"].get<double>());
+  std::size_t i = 1;
+  while (i + 2 < gt.size() && gt[i].t < t) ++i;
+  const Eigen::Vector3d v_gt = (gt[i + 1].T_world_body.translation() - gt[i - 1].T_world_body.translation()) /
+                               toSeconds(gt[i + 1].t - gt[i - 1].t);
+  ASSERT_GT(v_gt.norm(), 0.5) << "the course should be moving by its last sweep";
+  const Eigen::Vector3d v(last["v_world"][0].get<double>(), last["v_world"][1].get<double>(),
+                          last["v_world"][2].get<double>());
+  EXPECT_NEAR(v.norm(), v_gt.norm(), 0.05) << v.transpose() << " vs " << v_gt.transpose();
+}
+TEST_F(SimRun, WithoutTheImuTheRunHasNoVelocityOrBiasRecords) {
+  ASSERT_EQ(lidar_.exit_code, 0) << lidar_.output;
+  for (const Json& scan : readJson(out(false) / "report.json")["scans"]) EXPECT_FALSE(scan.contains("v_world"));
 }
 
 TEST_F(SimRun, WithoutTheImuTheRunIsLidarOnlyAndStillInTheImuFrame) {
