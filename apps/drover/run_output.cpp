@@ -31,6 +31,14 @@ Trajectory inBodyFrame(const Trajectory& lidar, const RunContext& c) {
   return out;
 }
 
+// IMU-rate T_world_imu -> T_world_body in the frame of trajectory.tum (the lidar when the body is not the IMU).
+Trajectory imuRateInBodyFrame(const Trajectory& imu, const RunContext& c) {
+  if (c.ground_truth.body_frame == "imu") return imu;
+  Trajectory out = imu;
+  for (auto& p : out) p.T_world_body = p.T_world_body * c.calibration.T_imu_lidar;
+  return out;
+}
+
 // KITTI devkit frame: T_cam0(0)_cam0(i) = Tr T_lidar0_lidar_i Tr^-1 with Tr = T_cam0_lidar from calib.txt.
 void writeKittiTrajectory(const RunContext& c, const Trajectory& lidar) {
   if (c.format != "kitti" || lidar.empty()) return;
@@ -160,6 +168,23 @@ Json evaluate(const RunContext& c, const Trajectory& est) {
   return j;
 }
 
+// The IMU-rate odometry's count, rate [Hz] and, with ground truth, its own SE(3)-aligned translation APE [m].
+Json imuRateJson(const RunContext& c, const Trajectory& est) {
+  Json j = {{"poses", est.size()}};
+  if (est.size() < 3) return j;
+  j["rate_hz"] = static_cast<double>(est.size() - 1) / toSeconds(est.back().t - est.front().t);
+  if (c.ground_truth.poses.empty()) return j;
+  eval::ApeOptions options;
+  options.alignment = eval::Alignment::kSe3;
+  options.association.max_diff = 10'000'000;  // 10 ms, evo's default
+  try {
+    j["ape"] = statisticsJson(eval::computeApe(c.ground_truth.poses, est, options).stats);
+  } catch (const std::invalid_argument& e) {
+    j["ape"] = {{"error", e.what()}};
+  }
+  return j;
+}
+
 }  // namespace
 
 void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r) {
@@ -169,6 +194,8 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
     io::writeTum(inRun(c, "keyframes.tum"), inBodyFrame(odometry.keyframeTrajectory(), c));
   }
   writeKittiTrajectory(c, odometry.trajectory());
+  const Trajectory imu_rate = imuRateInBodyFrame(odometry.imuRateTrajectory(), c);
+  if (!imu_rate.empty()) io::writeTum(inRun(c, "trajectory_imu_rate.tum"), imu_rate);
   const lidar::PointCloud map = odometry.mapCloud(kMapLeaf);
   io::writePcdBinary(inRun(c, "map.pcd"), map);
   io::writePlyBinary(inRun(c, "map.ply"), map);
@@ -188,6 +215,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["timings"] = timingsJson(r);
   report["ape"] = evaluate(c, est);
   report["loops"] = loopsJson(c, odometry);
+  if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
   report["scans"] = scansJson(r);
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",

@@ -4,6 +4,8 @@
 //                         simulated and IMU datasets, the lidar for KITTI odometry), TUM format
 //   trajectory_kitti.txt  KITTI odometry only: one line per sweep, camera-0 frame, first pose identity
 //   keyframes.tum         the keyframes' poses, same frame as trajectory.tum
+//   trajectory_imu_rate.tum  with the IMU: the IMU-rate odometry (the fused state propagated to each IMU sample as
+//                         it arrives), same frame as trajectory.tum
 //   map.pcd, map.ply      the keyframes' clouds in the world frame (binary)
 //   report.json           counts, per-stage timings, degenerate sweeps, resets, and the APE when there is ground truth
 //   ape.json, ape.png     APE (translation, SE(3)-aligned) against the ground truth, when there is one

@@ -99,10 +99,16 @@ std::optional<lidar::SweepMotion> ImuFusion::sweepMotion(Time t0, Time t_end) co
 }
 
 std::optional<Eigen::Isometry3d> ImuFusion::predictLidarPose(Time t) const {
+  const std::optional<Eigen::Isometry3d> T_world_imu = propagatedImuPose(t);
+  if (!T_world_imu) return std::nullopt;
+  return *T_world_imu * T_imu_lidar_;
+}
+
+std::optional<Eigen::Isometry3d> ImuFusion::propagatedImuPose(Time t) const {
   if (!initialized_) return std::nullopt;
   const std::optional<imu::NavState> s = propagator_.stateAt(t);
   if (!s) return std::nullopt;
-  return s->T_world_imu * T_imu_lidar_;
+  return s->T_world_imu;
 }
 
 Eigen::Isometry3d ImuFusion::initialLidarPose() const {

@@ -40,6 +40,9 @@ class ImuFusion {
 
   std::optional<lidar::SweepMotion> sweepMotion(Time t0, Time t_end) const;
   std::optional<Eigen::Isometry3d> predictLidarPose(Time t) const;
+  // The IMU's pose T_world_imu at t, propagated from the newest fused state through the buffered samples (LIO-SAM's
+  // IMU-rate odometry); nullopt before initialisation or outside the propagated range.
+  std::optional<Eigen::Isometry3d> propagatedImuPose(Time t) const;
   // Pose of the first sweep: gravity-aligned from the IMU attitude when initialised, else the identity.
   Eigen::Isometry3d initialLidarPose() const;
 

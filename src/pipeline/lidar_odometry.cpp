@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <deque>
+#include <limits>
 #include <stdexcept>
 
 #include "lidar/deskew.hpp"
@@ -33,6 +34,7 @@ struct LidarOdometry::Impl {
   ImuFusion fusion;
   std::deque<LidarScan> pending;  // sweeps waiting for the IMU to cover their end (time order)
   Trajectory trajectory;          // T_world_lidar per processed sweep
+  Trajectory imu_rate;            // T_world_imu per IMU sample after initialisation (imuRateTrajectory())
   Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
   OdometryStats stats;
   LoopClosure loops;
@@ -85,8 +87,15 @@ LidarOdometry::~LidarOdometry() = default;
 
 std::vector<ScanOutcome> LidarOdometry::process(const Measurement& m) {
   if (const auto* imu = std::get_if<ImuSample>(&m)) {
-    if (impl_->config.use_imu) impl_->fusion.addImu(*imu);
-    return impl_->drain(false);
+    if (!impl_->config.use_imu) return impl_->drain(false);
+    impl_->fusion.addImu(*imu);
+    std::vector<ScanOutcome> done = impl_->drain(false);
+    // After the drain, so that a sweep this sample completed is already fused into the published state.
+    const Time last = impl_->imu_rate.empty() ? std::numeric_limits<Time>::min() : impl_->imu_rate.back().t;
+    if (imu->t > last)
+      if (const std::optional<Eigen::Isometry3d> T = impl_->fusion.propagatedImuPose(imu->t))
+        impl_->imu_rate.push_back({imu->t, *T});
+    return done;
   }
   if (const auto* scan = std::get_if<LidarScan>(&m)) return impl_->onScan(*scan);
   return {};  // camera frames belong to the VIS
@@ -95,6 +104,8 @@ std::vector<ScanOutcome> LidarOdometry::process(const Measurement& m) {
 std::vector<ScanOutcome> LidarOdometry::finish() { return impl_->drain(true); }
 
 const Trajectory& LidarOdometry::trajectory() const { return impl_->trajectory; }
+
+const Trajectory& LidarOdometry::imuRateTrajectory() const { return impl_->imu_rate; }
 
 Trajectory LidarOdometry::keyframeTrajectory() const {
   Trajectory out;

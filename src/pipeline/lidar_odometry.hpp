@@ -100,6 +100,11 @@ class LidarOdometry {
   // its keyframe's corrected pose (the pose relative to the keyframe the sweep followed is kept).
   const Trajectory& trajectory() const;
   Trajectory keyframeTrajectory() const;    // T_world_lidar of the keyframes
+  // IMU-rate odometry (LIO-SAM's imuPreintegration output), T_world_imu at every accepted IMU sample after the
+  // initialisation: the newest fused state propagated by the IMU as each sample arrives, i.e. what a live system
+  // would publish at that moment. Causal: loop corrections move it from the next sample on, never backwards. Empty
+  // without the IMU.
+  const Trajectory& imuRateTrajectory() const;
   // The keyframes' full clouds in the world frame, voxel-downsampled with leaf [m].
   lidar::PointCloud mapCloud(float leaf) const;
   const OdometryStats& stats() const;

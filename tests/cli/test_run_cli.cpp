@@ -225,9 +225,30 @@ TEST_F(SimRun, WithTheImuTheRunIsLidarPlusImuWithOnePosePerSweepInTheImuFrame) {
                           last["v_world"][2].get<double>());
   EXPECT_NEAR(v.norm(), v_gt.norm(), 0.05) << v.transpose() << " vs " << v_gt.transpose();
 }
+TEST_F(SimRun, WithTheImuTheRunWritesTheImuRateOdometryInTheImuFrame) {
+  ASSERT_EQ(imu_.exit_code, 0) << imu_.output;
+  const Trajectory fast = io::readTum((out(true) / "trajectory_imu_rate.tum").string());
+  const Json r = readJson(out(true) / "report.json");
+  // 200 Hz from the end of the 1 s initialisation window to the end of the 4 s course, the report saying the same
+  // (its accuracy is the pipeline test's; on this straight course the SE(3) alignment of the APE is undefined).
+  EXPECT_NEAR(static_cast<double>(fast.size()), 200.0 * 3.0, 20.0);
+  ASSERT_TRUE(r.contains("imu_rate"));
+  EXPECT_EQ(r["imu_rate"]["poses"].get<std::size_t>(), fast.size());
+  EXPECT_NEAR(r["imu_rate"]["rate_hz"].get<double>(), 200.0, 1.0);
+  EXPECT_TRUE(r["imu_rate"].contains("ape"));
+  // The sweeps' poses are among its times, in the same frame: the sweep pose and the IMU-rate pose at the last
+  // sweep agree to the propagation between fusions (centimetres).
+  const Trajectory sweeps = io::readTum((out(true) / "trajectory.tum").string());
+  const StampedPose& last = sweeps.back();
+  const auto it = std::find_if(fast.begin(), fast.end(), [&](const StampedPose& p) { return p.t >= last.t; });
+  ASSERT_NE(it, fast.end());
+  EXPECT_LT((it->T_world_body.translation() - last.T_world_body.translation()).norm(), 0.05);
+}
 TEST_F(SimRun, WithoutTheImuTheRunHasNoVelocityOrBiasRecords) {
   ASSERT_EQ(lidar_.exit_code, 0) << lidar_.output;
   for (const Json& scan : readJson(out(false) / "report.json")["scans"]) EXPECT_FALSE(scan.contains("v_world"));
+  EXPECT_FALSE(fs::exists(out(false) / "trajectory_imu_rate.tum"));
+  EXPECT_FALSE(readJson(out(false) / "report.json").contains("imu_rate"));
 }
 
 TEST_F(SimRun, WithoutTheImuTheRunIsLidarOnlyAndStillInTheImuFrame) {

@@ -2,6 +2,7 @@
 // IMU, deterministic, and robust to each kind of bad input (issue 4) -- a warning counted, no crash, no divergence.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -143,6 +144,50 @@ TEST(LidarOdometry, EverySweepReportsTheSmoothersVelocityAndBiasesWhichMatchTheT
   // of the simulator's (its random walk moves it by < 0.1 mrad/s over the 16 s).
   const Eigen::Vector3d true_gyro_bias = sim::SimulatorConfig::defaults().imu.initial_gyro_bias;
   EXPECT_LT((outcomes.back().gyro_bias - true_gyro_bias).norm(), 5e-4) << outcomes.back().gyro_bias.transpose();
+}
+
+TEST(LidarOdometry, ImuRateOdometryFollowsTheTruthAtEveryImuSampleAfterInitialisation) {
+  LidarOdometry odometry(simConfig(true), course().calibration);
+  std::size_t imu_samples = 0;
+  for (const Measurement& m : course().stream) {
+    imu_samples += std::holds_alternative<ImuSample>(m);
+    odometry.process(m);
+  }
+  odometry.finish();
+  const Trajectory& fast = odometry.imuRateTrajectory();
+  // Every sample from the first sweep on (the IMU is initialised there; the stream's IMU starts with it).
+  ASSERT_GT(fast.size(), imu_samples - 2 * 200);  // 200 Hz
+  EXPECT_LE(fast.size(), imu_samples);
+  for (std::size_t i = 1; i < fast.size(); ++i) ASSERT_GT(fast[i].t, fast[i - 1].t) << i;
+  // In the truth's frame through the first sweep's pose (as runOn aligns): each propagated pose is within a few
+  // centimetres of the truth at its sample, between sweeps as well as at them.
+  const Trajectory& sweeps = odometry.trajectory();
+  const Eigen::Isometry3d T_lidar_imu = course().calibration.T_imu_lidar.inverse();
+  const Trajectory& truth = course().truth;
+  auto truthAt = [&](Time t) {
+    const auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                                     [](const StampedPose& p, Time x) { return p.t < x; });
+    EXPECT_TRUE(it != truth.end() && it->t == t) << "no ground truth at " << t;
+    return it == truth.end() ? truth.back().T_world_body : it->T_world_body;
+  };
+  const Eigen::Isometry3d T_truth_est = truthAt(sweeps.front().t) * (sweeps.front().T_world_body * T_lidar_imu).inverse();
+  double worst = 0, sum_sq = 0;
+  for (const StampedPose& p : fast) {
+    const double e = ((T_truth_est * p.T_world_body).translation() - truthAt(p.t).translation()).norm();
+    worst = std::max(worst, e);
+    sum_sq += e * e;
+  }
+  const double rmse = std::sqrt(sum_sq / static_cast<double>(fast.size()));
+  std::printf("IMU-rate odometry: %zu poses, rmse %.4f m, max %.4f m\n", fast.size(), rmse, worst);
+  EXPECT_LT(rmse, 0.05);
+  EXPECT_LT(worst, 0.15);
+}
+
+TEST(LidarOdometry, WithoutTheImuThereIsNoImuRateOdometry) {
+  LidarOdometry odometry(simConfig(false), course().calibration);
+  for (const Measurement& m : course().stream) odometry.process(m);
+  odometry.finish();
+  EXPECT_TRUE(odometry.imuRateTrajectory().empty());
 }
 
 TEST(LidarOdometry, LidarOnlyTracksTheSameCourse) {
