@@ -16,40 +16,19 @@
 #include <string>
 
 #include "geometry/so3.hpp"
-#include "io/config.hpp"
 #include "io/dataset.hpp"
-#include "io/odometry/odometry_config_io.hpp"
-#include "pipeline/lidar_odometry.hpp"
+#include "support/kitti_lidar_snippet.hpp"
 #include "support/shared_data.hpp"
 
 namespace drover {
 namespace {
-
-struct SnippetResult {
-  Trajectory estimate, truth;  // T_world_lidar of the 10 scans
-  pipeline::OdometryStats stats;
-};
-
-SnippetResult runSnippet(const std::string& sequence) {
-  const std::string config = std::string(DROVER_SOURCE_DIR) + "/config/kitti.yaml";
-  io::DatasetOptions options = io::loadDatasetOptions(config);
-  options.load_images = false;
-  options.kitti_max_frames = 10;
-  auto reader = io::openDataset(test::sharedData("kitti/sequences/" + sequence).string(), "kitti", options);
-  pipeline::LidarOdometry odometry(io::loadOdometryConfig(config), reader->calibration());
-  while (auto m = reader->next()) odometry.process(*m);
-  odometry.finish();
-  SnippetResult r{odometry.trajectory(), reader->groundTruth().poses, odometry.stats()};
-  r.truth.resize(std::min(r.truth.size(), r.estimate.size()));
-  return r;
-}
 
 double angleDeg(const Eigen::Isometry3d& T) { return geometry::rotationAngle(T.linear()) * 180.0 / std::numbers::pi; }
 
 void expectWithinBounds(const std::string& sequence, double max_relative_translation, double max_rotation_deg,
                         double max_step_translation, double max_step_rotation_deg) {
   DROVER_REQUIRE_SHARED(test::sharedData("kitti/sequences/" + sequence + "/velodyne/000009.bin"));
-  const SnippetResult r = runSnippet(sequence);
+  const test::KittiLidarSnippet r = test::runKittiLidarSnippet(sequence);
   ASSERT_EQ(r.estimate.size(), 10u);
   ASSERT_EQ(r.truth.size(), 10u);
   EXPECT_EQ(r.stats.not_converged, 0u);
