@@ -6,9 +6,12 @@
 // 14 frames are a constant-velocity extrapolation (steps alternate between 0.8587 and 0.8577 m to the tenth of a
 // millimetre, then start to vary smoothly at frame 14), while the scans themselves show the car accelerating: edges
 // alone, planes alone and point-to-plane on the full clouds all put scan 1 at 0.68 m from scan 0 from any starting
-// guess (0 to 1 m), and 05, whose reference does vary, meets the bound. The 00 test therefore checks that the
-// reference still has that flat start (so the exception cannot outlive the data) and holds the estimate to the
-// bounds that the mismatch allows (14 % and 1.5 deg), which still catch a broken matcher.
+// guess (0 to 1 m), and 05, whose reference does vary, meets the bound. The camera agrees with the lidar, not with
+// the reference: test_kitti_camera_crosscheck estimates camera 2's motion from its own images (PnP on lidar depth,
+// essential matrices for the rotation), finds it within 1.2 % / 0.02 deg of the reference on 05, and on 00 within
+// 1.1 % / 0.16 deg of this lidar odometry -- issue 4's bounds, held there against the camera -- while 13 % / 1.2 deg
+// from the reference. Here, the 00 test checks that the reference still has that flat start (so the exception cannot
+// outlive the data) and holds the estimate to the bounds that the mismatch allows (14 % and 1.5 deg).
 #include <gtest/gtest.h>
 
 #include <cmath>
