@@ -141,12 +141,18 @@ Json scansJson(const RunRecord& r) {
   return a;
 }
 
+// Translation APE after SE(3) alignment, associated within 10 ms (evo's default).
+eval::ApeOptions se3ApeOptions() {
+  eval::ApeOptions options;
+  options.alignment = eval::Alignment::kSe3;
+  options.association.max_diff = 10'000'000;  // [ns]
+  return options;
+}
+
 // APE of the translation with SE(3) alignment (and the rotation angle), printed as evo prints it.
 Json evaluate(const RunContext& c, const Trajectory& est) {
   if (c.ground_truth.poses.empty() || est.size() < 3) return nullptr;
-  eval::ApeOptions options;
-  options.alignment = eval::Alignment::kSe3;
-  options.association.max_diff = 10'000'000;  // 10 ms, evo's default
+  eval::ApeOptions options = se3ApeOptions();
   Json j;
   try {
     const eval::ApeResult r = eval::computeApe(c.ground_truth.poses, est, options);
@@ -174,11 +180,8 @@ Json imuRateJson(const RunContext& c, const Trajectory& est) {
   if (est.size() < 3) return j;
   j["rate_hz"] = static_cast<double>(est.size() - 1) / toSeconds(est.back().t - est.front().t);
   if (c.ground_truth.poses.empty()) return j;
-  eval::ApeOptions options;
-  options.alignment = eval::Alignment::kSe3;
-  options.association.max_diff = 10'000'000;  // 10 ms, evo's default
   try {
-    j["ape"] = statisticsJson(eval::computeApe(c.ground_truth.poses, est, options).stats);
+    j["ape"] = statisticsJson(eval::computeApe(c.ground_truth.poses, est, se3ApeOptions()).stats);
   } catch (const std::invalid_argument& e) {
     j["ape"] = {{"error", e.what()}};
   }
