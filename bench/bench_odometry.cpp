@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/drover/heap_tuning.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "io/odometry/odometry_config_io.hpp"
@@ -127,4 +128,12 @@ BENCHMARK(BM_LioKitti00LidarOnly)->Unit(benchmark::kMillisecond)->UseRealTime()-
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// As `drover run` does (apps/drover/heap_tuning.hpp): the benchmark measures the pipeline as the app runs it.
+int main(int argc, char** argv) {
+  drover::cli::tuneHeapForSweeps();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

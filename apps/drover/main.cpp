@@ -5,8 +5,10 @@
 #include <exception>
 
 #include "apps/drover/commands.hpp"
+#include "apps/drover/heap_tuning.hpp"
 
 int main(int argc, char** argv) {
+  drover::cli::tuneHeapForSweeps();
   CLI::App app{"Drover: lidar-visual-inertial SLAM for mobile robots in hard places"};
   app.require_subcommand(1);
   bool quiet = false;
