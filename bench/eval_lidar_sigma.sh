@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # How the lidar pose's sigma in the IMU smoother (odometry.lidar_sigma_position [m] / lidar_sigma_rotation [rad])
 # decides the LIS's drift on simulated courses (issue 4's farm bound). For each pair below, config/farm_sim.yaml with
-# those two keys replaced runs `drover run --no-loop --no-camera` (lidar + IMU, the LIS alone) on each dataset folder,
+# those two keys set runs `drover run --no-loop --no-camera` (lidar + IMU, the LIS alone) on each dataset folder,
 # and tools/course_report.py gives drift and the per-segment figures. Writes bench/out/lidar_sigma.md.
 # Usage: bash bench/eval_lidar_sigma.sh [dataset ...]   (default: out/sim/farm, which scripts/run.sh generates)
 set -euo pipefail
@@ -18,9 +18,10 @@ trap 'rm -rf "$tmp"' EXIT
 for pair in "${SIGMAS[@]}"; do
   read -r pos rot <<<"$pair"
   cfg="$tmp/sigma_${pos}_${rot}.yaml"
-  sed -e "s/^\(  lidar_sigma_position:\) *[0-9.e-]*/\1 $pos/" -e "s/^\(  lidar_sigma_rotation:\) *[0-9.e-]*/\1 $rot/" \
-    config/farm_sim.yaml >"$cfg"
-  grep -q "lidar_sigma_position: $pos\$\|lidar_sigma_position: $pos " "$cfg" || { echo "sed failed on $cfg" >&2; exit 1; }
+  # Drop the keys if the config sets them, then put the pair first in the odometry: section.
+  sed -e '/^  lidar_sigma_position:/d' -e '/^  lidar_sigma_rotation:/d' \
+    -e "s/^odometry:\$/odometry:\n  lidar_sigma_position: $pos\n  lidar_sigma_rotation: $rot/" config/farm_sim.yaml >"$cfg"
+  [ "$(grep -c "^  lidar_sigma_position: $pos\$" "$cfg")" = 1 ] || { echo "could not set the sigmas in $cfg" >&2; exit 1; }
   for data in "${DATASETS[@]}"; do
     name="$(basename "$data")_${pos}_${rot}"
     run="$OUT_ROOT/runs/sigma_$name"
