@@ -50,6 +50,18 @@ OdometryConfig simConfig(bool imu) {
   return c;
 }
 
+// Index of the ground-truth sample stamped exactly t (the truth is at 200 Hz, on the IMU's and the sweeps' stamps);
+// a test failure and the nearest later index when there is none.
+std::size_t truthIndex(Time t) {
+  const Trajectory& truth = course().truth;
+  const auto it =
+      std::lower_bound(truth.begin(), truth.end(), t, [](const StampedPose& p, Time x) { return p.t < x; });
+  if (it == truth.end() || it->t != t) ADD_FAILURE() << "no ground truth at " << t;
+  return std::min<std::size_t>(static_cast<std::size_t>(it - truth.begin()), truth.size() - 1);
+}
+
+const Eigen::Isometry3d& truthAt(Time t) { return course().truth[truthIndex(t)].T_world_body; }
+
 struct OdometryRun {
   Trajectory imu_poses;  // T_world_imu per sweep
   OdometryStats stats;
@@ -68,13 +80,7 @@ OdometryRun runOn(const std::vector<Measurement>& stream, const OdometryConfig& 
     r.imu_poses.push_back(p);
   }
   const Trajectory& truth = course().truth;
-  auto at = [&](Time t) {
-    for (const StampedPose& p : truth)
-      if (p.t == t) return p.T_world_body;
-    ADD_FAILURE() << "no ground truth at " << t;
-    return Eigen::Isometry3d(Eigen::Isometry3d::Identity());
-  };
-  const Eigen::Isometry3d T_truth_est = at(r.imu_poses.front().t) * r.imu_poses.front().T_world_body.inverse();
+  const Eigen::Isometry3d T_truth_est = truthAt(r.imu_poses.front().t) * r.imu_poses.front().T_world_body.inverse();
   Trajectory aligned = r.imu_poses;
   for (StampedPose& p : aligned) p.T_world_body = T_truth_est * p.T_world_body;
   r.ape_rmse = eval::computeApe(truth, aligned, eval::ApeOptions{}).stats.rmse;
@@ -107,13 +113,9 @@ TEST(LidarOdometry, LidarAndImuTrackTheSimulatedCourseToCentimetres) {
 // Velocity of the truth at t [m/s] by a central difference of its 200 Hz positions.
 Eigen::Vector3d truthVelocity(Time t) {
   const Trajectory& truth = course().truth;
-  for (std::size_t i = 1; i + 1 < truth.size(); ++i) {
-    if (truth[i].t != t) continue;
-    return (truth[i + 1].T_world_body.translation() - truth[i - 1].T_world_body.translation()) /
-           toSeconds(truth[i + 1].t - truth[i - 1].t);
-  }
-  ADD_FAILURE() << "no ground truth at " << t;
-  return Eigen::Vector3d::Zero();
+  const std::size_t i = std::clamp<std::size_t>(truthIndex(t), 1, truth.size() - 2);
+  return (truth[i + 1].T_world_body.translation() - truth[i - 1].T_world_body.translation()) /
+         toSeconds(truth[i + 1].t - truth[i - 1].t);
 }
 
 TEST(LidarOdometry, EverySweepReportsTheSmoothersVelocityAndBiasesWhichMatchTheTruth) {
@@ -163,13 +165,6 @@ TEST(LidarOdometry, ImuRateOdometryFollowsTheTruthAtEveryImuSampleAfterInitialis
   // centimetres of the truth at its sample, between sweeps as well as at them.
   const Trajectory& sweeps = odometry.trajectory();
   const Eigen::Isometry3d T_lidar_imu = course().calibration.T_imu_lidar.inverse();
-  const Trajectory& truth = course().truth;
-  auto truthAt = [&](Time t) {
-    const auto it = std::lower_bound(truth.begin(), truth.end(), t,
-                                     [](const StampedPose& p, Time x) { return p.t < x; });
-    EXPECT_TRUE(it != truth.end() && it->t == t) << "no ground truth at " << t;
-    return it == truth.end() ? truth.back().T_world_body : it->T_world_body;
-  };
   const Eigen::Isometry3d T_truth_est = truthAt(sweeps.front().t) * (sweeps.front().T_world_body * T_lidar_imu).inverse();
   double worst = 0, sum_sq = 0;
   for (const StampedPose& p : fast) {
