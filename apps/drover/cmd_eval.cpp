@@ -73,7 +73,20 @@ void loadBoth(const CommonOptions& o, Trajectory& ref, Trajectory& est) {
   requireWritableParent(o.plot, "--plot");
   ref = io::readTrajectory(o.ref, format, optionalPath(o.ref_times));
   est = io::readTrajectory(o.est, format, optionalPath(o.est_times));
+  if (ref.empty()) throw std::invalid_argument(o.ref + ": no poses");
+  if (est.empty()) throw std::invalid_argument(o.est + ": no poses");
   spdlog::info("loaded {} reference poses from {}, {} estimated poses from {}", ref.size(), o.ref, est.size(), o.est);
+}
+
+// Runs a metric; its complaints (no matching stamps, a degenerate alignment...) name the files, as
+// "EST (against REF): what".
+template <typename Metric>
+auto onFiles(const CommonOptions& o, Metric metric) {
+  try {
+    return metric();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(fmt::format("{} (against {}): {}", o.est, o.ref, e.what()));
+  }
 }
 
 Json commonJson(const char* metric, const CommonOptions& o, eval::PoseRelation relation, std::size_t pairs,
@@ -105,7 +118,7 @@ void runApe(const CommonOptions& o) {
   Trajectory ref, est;
   loadBoth(o, ref, est);
   eval::ApeOptions options{parseRelation(o.relation), parseAlignment(o.align), associationOptions(o)};
-  const eval::ApeResult r = eval::computeApe(ref, est, options);
+  const eval::ApeResult r = onFiles(o, [&] { return eval::computeApe(ref, est, options); });
   printResult(apeTitle(r), r.pairs, r.max_pairs, r.stats);
   if (!o.json.empty()) {
     const Json j = commonJson("ape", o, r.relation, r.pairs, r.max_pairs, r.stats, r.alignment, r.alignment_transform);
@@ -132,7 +145,7 @@ void runRpe(const RpeCliOptions& c) {
   options.unit =
       (c.delta_unit == "meters" || c.delta_unit == "m") ? eval::DeltaUnit::kMeters : eval::DeltaUnit::kFrames;
   options.pairs_from_reference = c.pairs_from_reference;
-  const eval::RpeResult r = eval::computeRpe(ref, est, options);
+  const eval::RpeResult r = onFiles(o, [&] { return eval::computeRpe(ref, est, options); });
   printResult(rpeTitle(r, options), r.pairs, r.max_pairs, r.stats);
   if (!o.json.empty()) {
     Json j = commonJson("rpe", o, r.relation, r.pairs, r.max_pairs, r.stats, r.alignment, r.alignment_transform);
@@ -163,7 +176,7 @@ void runKitti(const CommonOptions& o) {
   if (ref.size() != est.size())
     throw std::invalid_argument(fmt::format("KITTI drift matches poses by index: {} has {} poses but {} has {}", o.ref,
                                             ref.size(), o.est, est.size()));
-  const eval::KittiDriftResult r = eval::computeKittiDrift(posesOf(ref), posesOf(est));
+  const eval::KittiDriftResult r = onFiles(o, [&] { return eval::computeKittiDrift(posesOf(ref), posesOf(est)); });
   fmt::print("{}", kittiTable(r));
   if (!o.json.empty()) {
     Json j = kittiJson(r);

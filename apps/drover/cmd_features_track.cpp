@@ -101,6 +101,11 @@ void runTrack(const TrackOptions& o) {
     const double since = static_cast<double>(frame->t - t0) * 1e-9;
     if (since < o.start) continue;
     if ((o.duration > 0 && since > o.start + o.duration) || (o.max_frames > 0 && index >= o.max_frames)) break;
+    const CameraIntrinsics& k = camera.intrinsics();
+    if (frame->image.width != k.width || frame->image.height != k.height)
+      throw std::runtime_error(fmt::format("{}: image is {}x{} px but the camera calibration says {}x{} px",
+                                           frame->source, frame->image.width, frame->image.height, k.width,
+                                           k.height));
     const cv::Mat image = visual::imageView(frame->image);
     const visual::TrackingResult r = tracker.track(frame->t, image);
     summary.add(r);

@@ -2,6 +2,7 @@
 // ground truth), as text on stdout and optionally as JSON; optionally export the ground truth as TUM.
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -49,6 +50,7 @@ struct Summary {
   std::size_t imu_with_orientation = 0;
   double lidar_points = 0;  // summed over scans
   std::size_t lidar_with_time = 0, lidar_with_ring = 0;
+  std::size_t lidar_nonfinite = 0, scans_with_nonfinite = 0;  // points the reader dropped for NaN/inf values
   int width = 0, height = 0, channels = 0;  // of the first image
   bool image_size_varies = false;
 };
@@ -62,6 +64,8 @@ void addMeasurement(Summary& s, const Measurement& m) {
     s.lidar_points += static_cast<double>(scan->points.size());
     s.lidar_with_time += scan->has_time ? 1 : 0;
     s.lidar_with_ring += scan->has_ring ? 1 : 0;
+    s.lidar_nonfinite += scan->dropped_nonfinite;
+    s.scans_with_nonfinite += scan->dropped_nonfinite > 0 ? 1 : 0;
   } else if (const auto* frame = std::get_if<CameraFrame>(&m)) {
     if (s.camera.count == 0) {
       s.width = frame->image.width, s.height = frame->image.height, s.channels = frame->image.channels;
@@ -75,8 +79,13 @@ void addMeasurement(Summary& s, const Measurement& m) {
 Summary streamDataset(io::Reader& reader) {
   Summary s;
   Time previous = 0;
-  std::size_t index = 0;
+  std::size_t index = 0, notices_shown = 0;
+  const auto showDrops = [&] {
+    for (; notices_shown < reader.drops().notices.size(); ++notices_shown)
+      spdlog::warn("{}", reader.drops().notices[notices_shown]);
+  };
   while (const auto m = reader.next()) {
+    showDrops();
     const Time t = measurementTime(*m);
     // Readers promise non-decreasing time; a violation is a reader bug that would corrupt any run.
     if (index > 0 && t < previous)
@@ -87,6 +96,10 @@ Summary streamDataset(io::Reader& reader) {
     previous = t;
     ++index;
   }
+  showDrops();
+  if (s.lidar_nonfinite > 0)
+    spdlog::warn("{} non-finite lidar points dropped (in {} of {} scans)", s.lidar_nonfinite, s.scans_with_nonfinite,
+                 s.lidar.count);
   return s;
 }
 
@@ -138,6 +151,8 @@ Json summaryJson(const InfoOptions& o, const io::Reader& reader, const Summary& 
   j["lidar"]["mean_points_per_scan"] = s.lidar.count ? s.lidar_points / static_cast<double>(s.lidar.count) : 0.0;
   j["lidar"]["scans_with_time"] = s.lidar_with_time;
   j["lidar"]["scans_with_ring"] = s.lidar_with_ring;
+  j["lidar"]["points_nonfinite_dropped"] = s.lidar_nonfinite;
+  j["measurements_dropped"] = reader.drops().measurements;
   j["camera"] = streamJson(s.camera);
   j["camera"]["width"] = s.width;
   j["camera"]["height"] = s.height;
@@ -179,10 +194,16 @@ std::string summaryText(const Json& j, const Summary& s, const io::Reader& reade
     out += fmt::format("             {:.1f} points per scan; per-point time in {}/{} scans, ring in {}/{}\n",
                        j["lidar"]["mean_points_per_scan"].get<double>(), s.lidar_with_time, s.lidar.count,
                        s.lidar_with_ring, s.lidar.count);
+  if (s.lidar_nonfinite)
+    out += fmt::format("             {} non-finite points dropped (in {} scans)\n", s.lidar_nonfinite,
+                       s.scans_with_nonfinite);
   out += streamLine("Camera:", s.camera, "frames");
   if (s.camera.count)
     out += fmt::format("             {}x{} px, {} channel(s){}\n", s.width, s.height, s.channels,
                        s.image_size_varies ? " (size varies)" : "");
+  if (reader.drops().measurements)
+    out += fmt::format("Dropped:     {} measurements (a repeated or backwards stamp, or an unusable reading)\n",
+                       reader.drops().measurements);
   const Calibration& c = reader.calibration();
   out += "Calibration:\n" + matrixLines("T_imu_lidar", c.T_imu_lidar) + matrixLines("T_imu_cam", c.T_imu_cam);
   const CameraIntrinsics& k = c.camera;

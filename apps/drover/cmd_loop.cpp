@@ -58,7 +58,7 @@ void runPair(const PairOptions& o) {
     if (!std::filesystem::exists(p)) throw std::invalid_argument("scan " + p + " not found");
   const pipeline::OdometryConfig config = pairConfig(o);
   const pipeline::ScanPairResult r =
-      pipeline::compareScans(io::readKittiBin(o.a, 0, 0), io::readKittiBin(o.b, 0, 0), config);
+      pipeline::compareScans(io::readKittiBin(o.a, 0, 0), io::readKittiBin(o.b, 0, 0), config, o.a, o.b);
   const double threshold = config.loop.database.descriptor.threshold;
   const Eigen::Isometry3d& T = r.icp.T_candidate_query;
   spdlog::info("A: {} ({} points), B: {} ({} points)", o.a, r.points_a, o.b, r.points_b);

@@ -135,7 +135,14 @@ void runOdometry(const RunOptions& o) {
   RunProgress progress(total);
   RunRecord record;
   std::optional<Time> t_first;
+  const auto showReaderDrops = [&] {
+    const io::ReaderDrops& drops = reader->drops();
+    for (; record.reader_notices_shown < drops.notices.size(); ++record.reader_notices_shown)
+      spdlog::warn("{}", drops.notices[record.reader_notices_shown]);
+    record.measurements_dropped = drops.measurements;
+  };
   while (std::optional<Measurement> m = reader->next()) {
+    showReaderDrops();
     const Time t = measurementTime(*m);
     if (!t_first) t_first = t;
     const double since = toSeconds(t - *t_first);
@@ -147,6 +154,7 @@ void runOdometry(const RunOptions& o) {
     showNotices(odometry, o, record);
     progress.update(record.scans.size(), since - o.start);
   }
+  showReaderDrops();
   keep(odometry.finish(), record);
   showNotices(odometry, o, record);
   checkSomethingWasDone(odometry.stats(), o);

@@ -44,9 +44,10 @@ struct LoopEvalData {
 pipeline::OdometryConfig loopEvalConfig(const LoopEvalOptions& o);
 
 // The cloud the descriptor is made of, as drover run makes it: sanitize, times and rings inferred when the scan has
-// none, the feature extractor's (voxel-downsampled) full cloud. Throws std::invalid_argument when the scan has
-// fewer than config.min_points valid points.
-lidar::PointCloud descriptorCloud(LidarScan scan, const pipeline::OdometryConfig& config);
+// none, the feature extractor's (voxel-downsampled) full cloud. Throws std::invalid_argument naming the scan (`name`)
+// when it has fewer than config.min_points valid points.
+lidar::PointCloud descriptorCloud(LidarScan scan, const pipeline::OdometryConfig& config,
+                                  const std::string& name = "scan");
 
 LoopEvalData evaluateCourse(const LoopEvalOptions& o, const pipeline::OdometryConfig& config);
 LoopEvalData evaluatePairs(const LoopEvalOptions& o, const pipeline::OdometryConfig& config);

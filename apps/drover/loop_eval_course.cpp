@@ -163,6 +163,7 @@ LoopEvalData evaluateCourse(const LoopEvalOptions& o, const pipeline::OdometryCo
     travelled = 0;
     evaluator.addKeyframe(std::move(*scan), *T);
   }
+  for (const std::string& notice : reader->drops().notices) spdlog::warn("{}", notice);
   LoopEvalData d = evaluator.finish();
   d.scans = scans;
   return d;

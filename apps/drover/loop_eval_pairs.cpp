@@ -71,8 +71,9 @@ pipeline::OdometryConfig loopEvalConfig(const LoopEvalOptions& o) {
   return c;
 }
 
-lidar::PointCloud descriptorCloud(LidarScan scan, const pipeline::OdometryConfig& config) {
-  return pipeline::prepareScan(scan, config).full;
+lidar::PointCloud descriptorCloud(LidarScan scan, const pipeline::OdometryConfig& config,
+                                  const std::string& name) {
+  return pipeline::prepareScan(scan, config, name).full;
 }
 
 LoopEvalData evaluatePairs(const LoopEvalOptions& o, const pipeline::OdometryConfig& config) {
@@ -92,7 +93,7 @@ LoopEvalData evaluatePairs(const LoopEvalOptions& o, const pipeline::OdometryCon
     const std::string path = scanPath(o.dataset, frame);
     LidarScan scan = io::readKittiBin(path, 0, 0);
     const auto t0 = std::chrono::steady_clock::now();
-    loop::AugmentedScanContext a = loop::makeAugmentedScanContext(descriptorCloud(std::move(scan), config), sc);
+    loop::AugmentedScanContext a = loop::makeAugmentedScanContext(descriptorCloud(std::move(scan), config, path), sc);
     d.descriptor_ms += msSince(t0);
     ++d.keyframes;
     return cache.emplace(frame, std::move(a)).first->second;

@@ -98,13 +98,15 @@ Json timingsJson(const RunRecord& r) {
   return j;
 }
 
-Json statsJson(const pipeline::OdometryStats& s) {
+Json statsJson(const pipeline::OdometryStats& s, const RunRecord& r) {
   Json j;
+  j["measurements_dropped"] = r.measurements_dropped;
   j["scans_in"] = s.scans_in;
   j["scans_processed"] = s.scans_processed;
   j["scans_skipped_empty"] = s.scans_skipped_empty;
   j["scans_skipped_time"] = s.scans_skipped_time;
   j["points_dropped"] = s.points_dropped;
+  j["points_nonfinite"] = s.points_nonfinite;
   j["keyframes"] = s.keyframes;
   j["degenerate_scans"] = s.degenerate_scans;
   j["not_converged"] = s.not_converged;
@@ -232,7 +234,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["data_s"] = r.data_s;
   report["real_time_factor"] = r.wall_s > 0 ? r.data_s / r.wall_s : 0.0;
   report["map_points"] = map.size();
-  report["counts"] = statsJson(s);
+  report["counts"] = statsJson(s, r);
   report["timings"] = timingsJson(r);
   report["ape"] = evaluate(c, est);
   report["loops"] = loopsJson(c, odometry);

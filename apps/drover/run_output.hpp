@@ -31,6 +31,8 @@ struct RunRecord {
   double data_s = 0;  // [s] time spanned by the processed sweeps
   std::size_t notices_shown = 0;  // OdometryStats::notices already printed
   bool fusion_announced = false;  // the "fusing: ..." line was printed
+  std::size_t reader_notices_shown = 0;  // io::ReaderDrops::notices already printed
+  std::size_t measurements_dropped = 0;  // by the reader: a repeated or backwards stamp, or an unusable reading
 };
 
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be

@@ -13,7 +13,7 @@ namespace {
 // Umeyama on n point pairs given by accessors x(i), y(i) (so matched trajectories need no copies).
 template <typename X, typename Y>
 Sim3 umeyamaCore(Eigen::Index n, const X& x, const Y& y, bool with_scale) {
-  if (n == 0) throw std::invalid_argument("Umeyama alignment: no points");
+  if (n == 0) throw std::invalid_argument("no matched positions");
   const double inv_n = 1.0 / static_cast<double>(n);
   // Means (Eqs. 34, 35).
   Eigen::Vector3d mean_x = Eigen::Vector3d::Zero(), mean_y = Eigen::Vector3d::Zero();
@@ -39,8 +39,8 @@ Sim3 umeyamaCore(Eigen::Index n, const X& x, const Y& y, bool with_scale) {
   // so that collinear points carrying rounding noise are still reported as degenerate.
   const double eps = std::numeric_limits<double>::epsilon();
   if (!(d(1) > eps) || d(1) <= 1e-13 * d(0))
-    throw std::invalid_argument("Umeyama alignment: degenerate point set (" + std::to_string(n) +
-                                " points, need at least 3 that are not collinear)");
+    throw std::invalid_argument("the " + std::to_string(n) +
+                                " matched positions are all equal or on one line (need at least 3 that are not)");
   // S (Eq. 43): reflect the last axis when det(U) det(V) < 0 so that R is a proper rotation.
   Eigen::Vector3d s = Eigen::Vector3d::Ones();
   if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0.0) s(2) = -1.0;
@@ -110,8 +110,7 @@ Sim3 alignTrajectory(const Trajectory& est, const std::vector<std::size_t>& est_
     try {
       a = umeyamaAlignment(est, est_index, ref, ref_index, alignment == Alignment::kSim3);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("cannot align (") + alignmentName(alignment) + ") " +
-                                  std::to_string(est_index.size()) + " matched poses: " + e.what());
+      throw std::invalid_argument(std::string("cannot align (") + alignmentName(alignment) + "): " + e.what());
     }
   }
   est_aligned = applyAlignment(est, est_index, a);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <unordered_set>
 
 #include "io/bag_decompress.hpp"
@@ -92,6 +93,8 @@ std::pair<Fields, RecordSpan> parseRecord(const std::uint8_t* data, std::size_t 
 }
 
 BagFile::BagFile(std::string path) : path_(std::move(path)), in_(path_, std::ios::binary) {
+  // A folder opens as a stream on Linux and then fails every read: say what it is instead.
+  if (std::filesystem::is_directory(path_)) fail(path_, "", "is a folder, not a ROS bag file");
   if (!in_) fail(path_, "", "cannot open bag file");
   in_.seekg(0, std::ios::end);
   size_ = static_cast<std::uint64_t>(in_.tellg());

@@ -131,12 +131,22 @@ void BagReader::decodeNext() {
     fail(path_, record(sel), e.what());
   }
   const Time t = measurementTime(m);
-  if (t <= latest_[sel.stream])
-    fail(path_, record(sel), "time " + timeString(t) + " is not after the previous message's " +
-                                 timeString(latest_[sel.stream]) + " on this topic (backwards or duplicate stamp)");
-  latest_[sel.stream] = t;
   --remaining_[sel.stream];
   ++stats_.messages_decoded;
+  // A glitch of the IMU or its driver, like a spike: dropped with a warning, not the end of the bag.
+  if (const auto* s = std::get_if<ImuSample>(&m); s && (!s->omega_imu.allFinite() || !s->acc_imu.allFinite())) {
+    dropMeasurement(path_ + " (" + record(sel) + "): dropped: angular velocity or linear acceleration is not finite");
+    return;
+  }
+  // A driver that repeats or reorders a stamp: the message is dropped (a warning for the caller), so that the
+  // stream stays strictly increasing per topic, which the reorder buffer relies on.
+  if (t <= latest_[sel.stream]) {
+    dropMeasurement(path_ + " (" + record(sel) + "): dropped: stamp " + timeString(t) +
+                    (t == latest_[sel.stream] ? " repeats" : " is before") + " the previous message's " +
+                    timeString(latest_[sel.stream]) + " on this topic");
+    return;
+  }
+  latest_[sel.stream] = t;
   heap_.push_back({std::move(m), t, sel.entry.time, seq_++, &sel});
   std::push_heap(heap_.begin(), heap_.end(),
                  [](const Pending& a, const Pending& b) { return heapAfter(a.t, a.seq, b.t, b.seq); });
@@ -150,29 +160,34 @@ bool BagReader::releasable() const {
   return true;
 }
 
-Measurement BagReader::pop() {
+std::optional<Measurement> BagReader::pop() {
   std::pop_heap(heap_.begin(), heap_.end(),
                 [](const Pending& a, const Pending& b) { return heapAfter(a.t, a.seq, b.t, b.seq); });
   Pending p = std::move(heap_.back());
   heap_.pop_back();
-  if (p.t < last_returned_)
-    fail(path_, record(*p.source),
-         "header stamp " + timeString(p.t) + " is earlier than the already returned measurement at " +
-             timeString(last_returned_) + ": its stamp lags the bag record time by more than " +
-             std::to_string(kReorderWindow / kNanosPerSecond) + " s relative to the other topics");
+  // Returning it would break the stream's time order; dropping it loses one late message.
+  if (p.t < last_returned_) {
+    dropMeasurement(path_ + " (" + record(*p.source) + "): dropped: header stamp " + timeString(p.t) +
+                    " is earlier than the already returned measurement at " + timeString(last_returned_) +
+                    " (it lags the bag record time by more than " +
+                    std::to_string(kReorderWindow / kNanosPerSecond) + " s relative to the other topics)");
+    return std::nullopt;
+  }
   last_returned_ = p.t;
   return std::move(p.m);
 }
 
 std::optional<Measurement> BagReader::next() {
   while (true) {
-    if (!heap_.empty() && releasable()) return pop();
+    if (!heap_.empty() && (releasable() || cursor_ >= selected_.size())) {
+      if (std::optional<Measurement> m = pop()) return m;
+      continue;
+    }
     if (cursor_ < selected_.size()) {
       decodeNext();
       continue;
     }
-    if (heap_.empty()) return std::nullopt;
-    return pop();
+    return std::nullopt;
   }
 }
 

@@ -5,9 +5,10 @@
 // chunk, one decompressed chunk cached). Measurement times are the messages' header stamps, which lag or lead the
 // record times by sensor/driver latency (a lidar sweep is recorded ~0.1-0.2 s after its start stamp), so decoded
 // measurements pass through a reorder buffer: one is returned once every topic still holding messages has shown
-// a later stamp, or once the bag's record time has moved kReorderWindow past it. Within a topic, stamps must
-// strictly increase; a measurement older than one already returned is an error (its stamp lags its record time
-// by more than the window) rather than silently out of order. Memory stays bounded by the window's messages.
+// a later stamp, or once the bag's record time has moved kReorderWindow past it. Within a topic, a message whose
+// stamp does not increase (duplicate or backwards) is dropped, and so is a measurement older than one already
+// returned (its stamp lags its record time by more than the window): each is counted in drops() with a notice
+// naming the message, rather than silently out of order. Memory stays bounded by the window's messages.
 //
 // Calibration comes from DatasetOptions::calibration (bags carry none); time offsets in it are not applied here.
 // Bags have no ground truth.
@@ -64,7 +65,7 @@ class BagReader final : public Reader {
   void selectConnections();
   void decodeNext();
   bool releasable() const;
-  Measurement pop();
+  std::optional<Measurement> pop();  // nullopt: the popped measurement was dropped as late
   std::string record(const Selected& s) const;
 
   std::string path_;

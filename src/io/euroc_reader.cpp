@@ -13,6 +13,7 @@
 
 #include "io/config.hpp"
 #include "io/error.hpp"
+#include "io/image_file_io.hpp"
 #include "io/text_parsing.hpp"
 #include "io/trajectory_io.hpp"
 
@@ -109,7 +110,8 @@ CameraIntrinsics readIntrinsics(const YAML::Node& root, const std::string& file)
 
 // ---- csv indexes -----------------------------------------------------------------------------------------------
 
-std::vector<ImuSample> readImuCsv(const std::string& path) {
+// Rows whose stamp does not advance are dropped, their warnings appended to `dropped`.
+std::vector<ImuSample> readImuCsv(const std::string& path, std::vector<std::string>& dropped) {
   std::vector<ImuSample> samples;
   for (const NumberedLine& line : readDataLines(path, "#")) {
     const std::string record = lineRecord(line.number);
@@ -117,8 +119,11 @@ std::vector<ImuSample> readImuCsv(const std::string& path) {
     requireColumns(fields, 7, path, record);
     ImuSample s;
     s.t = parseInt64(fields[0], path, record);
-    if (!samples.empty()) requireIncreasingTime(samples.back().t, s.t, path, record);
     const std::vector<double> v = parseDoubles(fields, 1, 6, path, record);
+    if (!samples.empty() && s.t <= samples.back().t) {
+      dropped.push_back(staleStampNotice(samples.back().t, s.t, path, record));
+      continue;
+    }
     s.omega_imu = Eigen::Vector3d(v[0], v[1], v[2]);
     s.acc_imu = Eigen::Vector3d(v[3], v[4], v[5]);
     samples.push_back(s);
@@ -133,15 +138,19 @@ struct ImageEntry {
   std::string record;  // "mav0/cam0/data.csv line N", for errors raised when the image is read
 };
 
-std::vector<ImageEntry> readImageCsv(const std::string& csv, const fs::path& image_dir) {
+std::vector<ImageEntry> readImageCsv(const std::string& csv, const fs::path& image_dir,
+                                     std::vector<std::string>& dropped) {
   std::vector<ImageEntry> entries;
   for (const NumberedLine& line : readDataLines(csv, "#")) {
     const std::string record = lineRecord(line.number);
     const auto fields = splitOn(line.text, ',');
     requireColumns(fields, 2, csv, record);
     const Time t = parseInt64(fields[0], csv, record);
-    if (!entries.empty()) requireIncreasingTime(entries.back().t, t, csv, record);
     if (fields[1].empty()) fail(csv, record, "empty image file name");
+    if (!entries.empty() && t <= entries.back().t) {
+      dropped.push_back(staleStampNotice(entries.back().t, t, csv, record));
+      continue;
+    }
     entries.push_back({t, (image_dir / std::string(fields[1])).string(), csv + " " + record});
   }
   return entries;
@@ -151,8 +160,7 @@ std::vector<ImageEntry> readImageCsv(const std::string& csv, const fs::path& ima
 
 Image decodeImage(const ImageEntry& entry, const CameraIntrinsics& cam) {
   if (!fs::exists(entry.path)) fail(entry.path, "listed in " + entry.record, "image file not found");
-  cv::Mat mat = cv::imread(entry.path, cv::IMREAD_UNCHANGED);
-  if (mat.empty()) fail(entry.path, "", "cannot decode image");
+  cv::Mat mat = decodeImageFile(entry.path);
   if (mat.depth() != CV_8U) fail(entry.path, "", "expected an 8-bit image");
   if (mat.channels() == 4) cv::cvtColor(mat, mat, cv::COLOR_BGRA2BGR);
   if (mat.channels() != 1 && mat.channels() != 3) fail(entry.path, "", "expected a grey or colour image");
@@ -213,12 +221,14 @@ GroundTruth readGroundTruth(const Layout& layout, const Eigen::Isometry3d& T_B_i
 class EurocReader final : public Reader {
  public:
   EurocReader(std::string name, Calibration calib, GroundTruth gt, std::vector<ImuSample> imu,
-              std::vector<ImageEntry> images)
+              std::vector<ImageEntry> images, const std::vector<std::string>& dropped)
       : name_(std::move(name)),
         calib_(std::move(calib)),
         gt_(std::move(gt)),
         imu_(std::move(imu)),
-        images_(std::move(images)) {}
+        images_(std::move(images)) {
+    for (const std::string& notice : dropped) dropMeasurement(notice);
+  }
 
   std::optional<Measurement> next() override {
     const bool has_imu = next_imu_ < imu_.size();
@@ -270,13 +280,14 @@ std::unique_ptr<Reader> openEuroc(const std::string& dir, const DatasetOptions& 
   Calibration calib = readEurocCalibration(layout.mav0.string());
   const Eigen::Isometry3d T_B_imu = readEurocSensorExtrinsics((layout.mav0 / "imu0" / "sensor.yaml").string());
   GroundTruth gt = readGroundTruth(layout, T_B_imu);
+  std::vector<std::string> dropped;  // rows whose stamp does not advance
   std::vector<ImuSample> imu;
-  if (options.load_imu) imu = readImuCsv((layout.mav0 / "imu0" / "data.csv").string());
+  if (options.load_imu) imu = readImuCsv((layout.mav0 / "imu0" / "data.csv").string(), dropped);
   std::vector<ImageEntry> images;
   if (options.load_images)
-    images = readImageCsv((layout.mav0 / "cam0" / "data.csv").string(), layout.mav0 / "cam0" / "data");
+    images = readImageCsv((layout.mav0 / "cam0" / "data.csv").string(), layout.mav0 / "cam0" / "data", dropped);
   return std::make_unique<EurocReader>(layout.root.filename().string(), std::move(calib), std::move(gt), std::move(imu),
-                                       std::move(images));
+                                       std::move(images), dropped);
 }
 
 }  // namespace drover::io

@@ -20,7 +20,8 @@ namespace drover::io {
 // `dir` is the sequence folder holding mav0/, or mav0 itself. Indexes IMU samples, image stamps, calibration
 // and ground truth up front; images are decoded lazily in next(). IMU and camera are merged in time order
 // (IMU first on equal stamps). options.load_imu / load_images are honoured (lidar: EuRoC has none).
-// Throws IoError naming file and record on any bad input.
+// Throws IoError naming file and record on any bad input, except that an IMU row or image whose stamp does not
+// advance is dropped with a warning in Reader::drops().
 std::unique_ptr<Reader> openEuroc(const std::string& dir, const DatasetOptions& options);
 
 // T_BS of one EuRoC sensor.yaml: sensor -> body. Accepts OpenCV's "%YAML:1.0" first line.

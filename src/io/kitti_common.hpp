@@ -13,7 +13,8 @@
 namespace drover::io {
 
 // A KITTI velodyne .bin: consecutive float32 (x, y, z, reflectance) records, lidar frame, metres.
-// Throws IoError naming the file when its size is not a multiple of 16 bytes or a value is NaN/inf.
+// Throws IoError naming the file when its size is not a multiple of 16 bytes; points with a NaN/inf value are
+// dropped and counted in LidarScan::dropped_nonfinite.
 // The scan has no per-point time or ring (has_time = has_ring = false); t and t_end are set from the arguments.
 LidarScan readKittiBin(const std::string& path, Time t, Time t_end);
 // KITTI raw "extract" scans: ASCII "x y z reflectance" per line. Same checks, errors name the line.
@@ -41,11 +42,20 @@ class KittiCalibFile {
   // The rotation is checked and orthonormalised (checkedRotation).
   Eigen::Isometry3d rigid34(const std::string& key) const;
   Eigen::Isometry3d rigidRT(const std::string& r_key, const std::string& t_key) const;
+  // A camera matrix (3x4 projection or 3x3 K) whose focal lengths (0,0) and (1,1) are checked to be > 0 [px], so
+  // that a zeroed P2 is an error naming the key, not a camera that projects everything to one pixel.
+  Eigen::Matrix<double, 3, 4> projection34(const std::string& key) const;
+  Eigen::Matrix3d intrinsics33(const std::string& key) const;
 
  private:
+  void requireFocalLengths(const std::string& key, double fx, double fy) const;
+
   std::string path_;
   std::map<std::string, std::vector<double>> numbers_;
   std::map<std::string, std::size_t> lines_;  // key -> line number, for error messages
+  // Keys whose values are not all numbers ("calib_time: 09-Jan-2012 13:57:47") -> first such value: an error only
+  // when a number is asked for, so a malformed "Tr:" is reported as malformed, not missing.
+  std::map<std::string, std::string> text_;
 };
 
 // The frame in which a rectified projection P = K [I | p/K] projects with K alone: the camera is displaced

@@ -55,7 +55,7 @@ KittiOdometryReader::KittiOdometryReader(const std::string& sequence_dir, const 
 void KittiOdometryReader::readCalibration() {
   const KittiCalibFile calib((fs::path(dir_) / "calib.txt").string());
   for (const char* key : {"P0", "P1", "P2", "P3"}) calib.get(key, 12);  // all four are part of the format
-  const Eigen::Matrix<double, 3, 4> P = calib.matrix34(options_.kitti_camera == 0 ? "P0" : "P2");
+  const Eigen::Matrix<double, 3, 4> P = calib.projection34(options_.kitti_camera == 0 ? "P0" : "P2");
   T_cam0_lidar_ = calib.rigid34("Tr");
   // No IMU: the body frame is the lidar.
   calibration_.T_imu_lidar = Eigen::Isometry3d::Identity();
@@ -113,6 +113,12 @@ std::optional<Measurement> KittiOdometryReader::next() {
       cam.t = times_[frame];
       cam.camera_id = options_.kitti_camera;
       cam.image = readImageFile(path);
+      // The calibrated size is image 0's (calib.txt has none); a sequence's images all share it.
+      const CameraIntrinsics& k = calibration_.camera;
+      if (cam.image.width != k.width || cam.image.height != k.height)
+        fail(path, frameRecord(frame),
+             "image is " + std::to_string(cam.image.width) + "x" + std::to_string(cam.image.height) +
+                 " px, frame 0's is " + std::to_string(k.width) + "x" + std::to_string(k.height));
       cam.source = path;
       ++frame_;
       scan_done_ = false;

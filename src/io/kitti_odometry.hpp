@@ -9,6 +9,11 @@
 // in which P2 projects with K alone; see rectifiedCameraOffset).
 // Time: times.txt seconds since the sequence start -> ns. Each frame's scan has t = t_end = that time (KITTI
 // timestamps a sweep once), the image the same time; at equal stamps the scan comes first.
+// Unlike a sensor's stamps (which the other readers drop with a warning when they repeat or go back), a times.txt
+// that does not strictly increase is an error naming the line: it is the frame index itself -- line k is
+// velodyne/k.bin, image k and poses.txt line k, and trajectory_kitti.txt and the devkit pair poses by line -- so
+// dropping a frame would shift every later pose against the ground truth. Non-finite points are dropped
+// (LidarScan::dropped_nonfinite).
 #include <memory>
 #include <string>
 #include <vector>

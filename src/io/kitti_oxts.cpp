@@ -109,6 +109,13 @@ Time parseKittiTimestamp(std::string_view text, const std::string& file, const s
   return secs * kNanosPerSecond + nanos;
 }
 
+std::vector<Time> readKittiTimestampsAsListed(const std::string& path) {
+  std::vector<Time> times;
+  for (const auto& line : readDataLines(path, "#"))
+    times.push_back(parseKittiTimestamp(line.text, path, lineRecord(line.number)));
+  return times;
+}
+
 std::vector<Time> readKittiTimestamps(const std::string& path) {
   std::vector<Time> times;
   for (const auto& line : readDataLines(path, "#")) {

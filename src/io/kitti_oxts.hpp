@@ -48,5 +48,8 @@ Eigen::Vector2d latLonToMercator(double lat_deg, double lon_deg, double scale);
 Time parseKittiTimestamp(std::string_view text, const std::string& file, const std::string& record);
 // A timestamps.txt: one such string a line, strictly increasing (IoError naming the line otherwise).
 std::vector<Time> readKittiTimestamps(const std::string& path);
+// The same without the order check, one time per data line (entry i = the drive's file i): for readers that drop
+// a measurement whose stamp does not advance. Lines are numbered i + 1 when the file has no blank or '#' lines.
+std::vector<Time> readKittiTimestampsAsListed(const std::string& path);
 
 }  // namespace drover::io

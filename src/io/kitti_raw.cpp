@@ -1,5 +1,6 @@
 #include "io/kitti_raw.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
@@ -92,7 +93,7 @@ void KittiRawReader::readCalibration(const std::string& drive_dir) {
     // Rectified reference frame: X_rect0 = R_rect_00 X_cam0; rectified camera x is offset by K^-1 P(:,3).
     Eigen::Isometry3d T_rect0_cam0 = Eigen::Isometry3d::Identity();
     T_rect0_cam0.linear() = checkedRotation(cam_to_cam.matrix33("R_rect_00"), cam_to_cam.path(), "key 'R_rect_00'");
-    const Eigen::Matrix<double, 3, 4> P = cam_to_cam.matrix34("P_rect_" + x);
+    const Eigen::Matrix<double, 3, 4> P = cam_to_cam.projection34("P_rect_" + x);
     calibration_.T_imu_cam = T_imu_cam0 * T_rect0_cam0.inverse() * rectifiedCameraOffset(P);
     cam.fx = P(0, 0), cam.fy = P(1, 1), cam.cx = P(0, 2), cam.cy = P(1, 2);
     cam.distortion = DistortionModel::kNone;
@@ -100,7 +101,7 @@ void KittiRawReader::readCalibration(const std::string& drive_dir) {
   } else {
     const Eigen::Isometry3d T_camx_cam0 = cam_to_cam.rigidRT("R_" + x, "T_" + x);
     calibration_.T_imu_cam = T_imu_cam0 * T_camx_cam0.inverse();
-    const Eigen::Matrix3d K = cam_to_cam.matrix33("K_" + x);
+    const Eigen::Matrix3d K = cam_to_cam.intrinsics33("K_" + x);
     cam.fx = K(0, 0), cam.fy = K(1, 1), cam.cx = K(0, 2), cam.cy = K(1, 2);
     cam.distortion = DistortionModel::kRadialTangential;
     cam.distortion_coeffs = cam_to_cam.get("D_" + x, 5);  // k1 k2 p1 p2 k3
@@ -108,6 +109,10 @@ void KittiRawReader::readCalibration(const std::string& drive_dir) {
   }
   if (cam_to_cam.has(size_key)) {
     const auto& s = cam_to_cam.get(size_key, 2);
+    for (double v : s)
+      if (!(v >= 1 && v <= 100000 && v == std::floor(v)))
+        fail(cam_to_cam.path(), "key '" + size_key + "'", "expected a width and a height in whole pixels, got " +
+                                                              formatDouble(s[0]) + " " + formatDouble(s[1]));
     cam.width = static_cast<int>(s[0]);
     cam.height = static_cast<int>(s[1]);
   }
@@ -120,23 +125,30 @@ void KittiRawReader::readOxts(const std::string& drive_dir) {
     return;  // no IMU wanted and no ground truth available
   }
   const std::string stamps = (oxts / "timestamps.txt").string();
-  const std::vector<Time> times = readKittiTimestamps(stamps);
+  const std::vector<Time> times = readKittiTimestampsAsListed(stamps);
   const std::size_t files = countFiles(oxts / "data", "txt");
   if (files != times.size())
     fail(stamps, "", "has " + std::to_string(times.size()) + " timestamps but " + (oxts / "data").string() + " has " +
                          std::to_string(files) + " .txt files");
   std::vector<OxtsRecord> records;
+  std::vector<Time> kept;  // the records' stamps, strictly increasing
   records.reserve(times.size());
   for (std::size_t i = 0; i < times.size(); ++i) {
     const fs::path p = oxts / "data" / numberedFile(i, "txt");
     if (!fs::exists(p)) fail(p.string(), frameRecord(i), "oxts record listed in timestamps.txt is missing");
-    records.push_back(readOxtsFile(p.string()));
+    OxtsRecord record = readOxtsFile(p.string());
+    if (!kept.empty() && times[i] <= kept.back()) {
+      dropMeasurement(staleStampNotice(kept.back(), times[i], stamps, frameRecord(i)));
+      continue;
+    }
+    records.push_back(record);
+    kept.push_back(times[i]);
   }
-  ground_truth_.poses = oxtsToPoses(records, times);
+  ground_truth_.poses = oxtsToPoses(records, kept);
   ground_truth_.body_frame = "imu";
   if (options_.load_imu) {
     imu_.reserve(records.size());
-    for (std::size_t i = 0; i < records.size(); ++i) imu_.push_back(oxtsToImu(records[i], times[i]));
+    for (std::size_t i = 0; i < records.size(); ++i) imu_.push_back(oxtsToImu(records[i], kept[i]));
   }
 }
 
@@ -147,13 +159,15 @@ KittiRawReader::FileStream KittiRawReader::indexStream(const std::string& folder
   s.data_dir = (base / "data").string();
   s.ext = ext;
   const std::string stamps = (base / "timestamps.txt").string();
-  s.t = readKittiTimestamps(stamps);
+  s.stamps = stamps;
+  s.t = readKittiTimestampsAsListed(stamps);
   s.t_end = s.t;
   if (with_start_end && fs::exists(base / "timestamps_start.txt")) {
     const std::string start_path = (base / "timestamps_start.txt").string();
     const std::string end_path = (base / "timestamps_end.txt").string();
-    s.t = readKittiTimestamps(start_path);
-    s.t_end = readKittiTimestamps(end_path);
+    s.stamps = start_path;
+    s.t = readKittiTimestampsAsListed(start_path);
+    s.t_end = readKittiTimestampsAsListed(end_path);
     if (s.t.size() != s.t_end.size())
       fail(end_path, "", "has " + std::to_string(s.t_end.size()) + " timestamps but timestamps_start.txt has " +
                              std::to_string(s.t.size()));
@@ -173,6 +187,7 @@ LidarScan KittiRawReader::loadScan() {
   if (!fs::exists(path)) fail(path, frameRecord(i), "velodyne scan listed in timestamps.txt is missing");
   LidarScan scan = sync_ ? readKittiBin(path, scans_.t[i], scans_.t_end[i])
                          : readKittiScanText(path, scans_.t[i], scans_.t_end[i]);
+  scans_.last = scans_.t[i];
   ++scans_.next;
   return scan;
 }
@@ -186,11 +201,19 @@ CameraFrame KittiRawReader::loadImage() {
   frame.camera_id = options_.kitti_camera;
   frame.image = readImageFile(path);
   frame.source = path;
+  images_.last = images_.t[i];
   ++images_.next;
   return frame;
 }
 
+void KittiRawReader::skipStale(FileStream& stream) {
+  for (; stream.hasNext() && stream.last && stream.t[stream.next] <= *stream.last; ++stream.next)
+    dropMeasurement(staleStampNotice(*stream.last, stream.t[stream.next], stream.stamps, frameRecord(stream.next)));
+}
+
 std::optional<Measurement> KittiRawReader::next() {
+  skipStale(scans_);
+  skipStale(images_);
   // Earliest of the three streams; at equal stamps IMU before lidar before camera.
   const bool has_imu = next_imu_ < imu_.size();
   const bool has_scan = scans_.hasNext();

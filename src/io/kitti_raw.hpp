@@ -14,8 +14,10 @@
 //    rad-tan distortion D_0x (k1 k2 p1 p2 k3).
 // Time: ns since 1970-01-01 with KITTI's local date-time strings read as UTC (see parseKittiTimestamp).
 // Scans: t = timestamps_start, t_end = timestamps_end (timestamps.txt when those are absent); no per-point time.
-// Order at equal stamps: IMU, then lidar, then camera.
+// Order at equal stamps: IMU, then lidar, then camera. A record or file whose stamp is not after the previous one of
+// its stream (KITTI raw's timestamps do repeat and jump back now and then) is dropped and counted in drops().
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +48,8 @@ class KittiRawReader : public Reader {
     std::string ext;       // "bin" | "txt" | "png"
     std::vector<Time> t;   // per file
     std::vector<Time> t_end;
+    std::string stamps;      // the timestamps file t comes from, for warnings
+    std::optional<Time> last;  // [ns] stamp of the last file returned
     std::size_t next = 0;
     bool enabled = false;
     bool hasNext() const { return enabled && next < t.size(); }
@@ -55,6 +59,8 @@ class KittiRawReader : public Reader {
   void readCalibration(const std::string& drive_dir);
   void readOxts(const std::string& drive_dir);
   FileStream indexStream(const std::string& folder, const std::string& ext, bool with_start_end) const;
+  // Drops (with a counted warning) the files at the stream's head whose stamp is not after the last one returned.
+  void skipStale(FileStream& stream);
   LidarScan loadScan();
   CameraFrame loadImage();
 

@@ -5,6 +5,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "io/image_file_io.hpp"
+
 namespace drover::io::ros {
 namespace {
 
@@ -46,8 +48,6 @@ ImuSample decodeImu(const std::uint8_t* data, std::size_t size) {
   in.take(9 * sizeof(double));  // angular_velocity_covariance
   s.acc_imu = readVector3(in);
   in.take(9 * sizeof(double));  // linear_acceleration_covariance
-  if (!s.omega_imu.allFinite() || !s.acc_imu.allFinite())
-    throw MessageError("IMU angular velocity or linear acceleration is not finite");
   const Eigen::Quaterniond q(qw, qx, qy, qz);
   // REP 145: covariance[0] == -1 marks "no orientation estimate".
   if (orientation_cov[0] != -1.0 && q.coeffs().allFinite() && std::abs(q.norm() - 1.0) < 1e-2)
@@ -110,12 +110,14 @@ CameraFrame decodeCompressedImage(const std::uint8_t* data, std::size_t size) {
   const std::uint8_t* bytes = in.take(n);
   if (format.find("compressedDepth") != std::string::npos)
     throw MessageError("compressed depth images ('" + format + "') are not supported");
+  if (const std::string problem = imageHeaderProblem(bytes, n); !problem.empty())
+    throw MessageError("compressed image ('" + format + "'): " + problem);
   const cv::Mat buffer(1, static_cast<int>(n), CV_8UC1, const_cast<std::uint8_t*>(bytes));
   cv::Mat m;
   try {
     m = cv::imdecode(buffer, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& e) {
-    throw MessageError("cannot decode compressed image ('" + format + "'): " + e.what());
+    throw MessageError("cannot decode compressed image ('" + format + "'): " + e.err);
   }
   if (m.empty()) throw MessageError("cannot decode compressed image ('" + format + "')");
   if (m.depth() != CV_8U) throw MessageError("compressed image is not 8-bit ('" + format + "')");

@@ -70,7 +70,8 @@ Header readHeader(WireReader& in);
 
 // sensor_msgs/Imu -> ImuSample at the header stamp. The orientation is kept only when the driver provides one
 // (orientation_covariance[0] != -1, REP 145) and it is a unit quaternion to within 1e-2 (drivers without an
-// orientation often send zeros); it is then normalized. Non-finite rates or accelerations are errors.
+// orientation often send zeros); it is then normalized. Non-finite rates or accelerations are returned as they
+// are (the bag reader drops such a sample with a warning).
 ImuSample decodeImu(const std::uint8_t* data, std::size_t size);
 
 // sensor_msgs/Image (mono8, 8UC1, bgr8, rgb8, 8UC3, bgra8, rgba8) -> CameraFrame at the header stamp; colour is

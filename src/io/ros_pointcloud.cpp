@@ -174,6 +174,7 @@ DecodedCloud decodePointCloud2(const std::uint8_t* data, std::size_t size) {
     }
   }
 
+  scan.dropped_nonfinite = out.dropped_nonfinite;
   scan.t = scan.t_end = out.stamp;
   if (time && !offsets_ns.empty()) {
     const auto [lo, hi] = std::minmax_element(offsets_ns.begin(), offsets_ns.end());

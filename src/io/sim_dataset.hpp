@@ -38,7 +38,9 @@
 //
 // The writer builds everything in DIR.partial/ and renames it to DIR only when complete, so an interrupted run
 // never leaves a folder that looks like a dataset. The reader checks every file and record and throws IoError
-// naming them (missing file or key, .bin size not a multiple of 24, non-finite values, time going backwards).
+// naming them (missing file or key, .bin size not a multiple of 24, unparsable values); as from real sensors, a
+// lidar point with a non-finite value is dropped (LidarScan::dropped_nonfinite) and an IMU row, scan or image
+// whose stamp does not advance is dropped with a warning in Reader::drops().
 #include <condition_variable>
 #include <cstdint>
 #include <deque>

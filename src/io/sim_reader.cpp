@@ -11,6 +11,7 @@
 
 #include "io/config.hpp"
 #include "io/error.hpp"
+#include "io/image_file_io.hpp"
 #include "io/sim_dataset.hpp"
 #include "io/text_parsing.hpp"
 #include "io/trajectory_io.hpp"
@@ -201,7 +202,8 @@ void readScenarioJson(const fs::path& path, SimDatasetDescription& d) {
 
 // ---- csv indexes -----------------------------------------------------------------------------------------------
 
-std::vector<ImuSample> readImuCsv(const std::string& path) {
+// Rows whose stamp does not advance are dropped (as from a real IMU), their warnings appended to `dropped`.
+std::vector<ImuSample> readImuCsv(const std::string& path, std::vector<std::string>& dropped) {
   if (!fs::exists(path)) fail(path, "", "IMU file not found");
   std::vector<ImuSample> samples;
   std::size_t columns = 0;
@@ -216,11 +218,14 @@ std::vector<ImuSample> readImuCsv(const std::string& path) {
     requireColumns(f, columns, path, record);
     ImuSample s;
     s.t = parseInt64(f[0], path, record);
-    if (!samples.empty()) requireIncreasingTime(samples.back().t, s.t, path, record);
     const std::vector<double> v = parseDoubles(f, 1, columns - 1, path, record);
     s.omega_imu = Eigen::Vector3d(v[0], v[1], v[2]);
     s.acc_imu = Eigen::Vector3d(v[3], v[4], v[5]);
     if (columns == 11) s.q_world_imu = checkedQuaternion(v[6], v[7], v[8], v[9], path, record);
+    if (!samples.empty() && s.t <= samples.back().t) {
+      dropped.push_back(staleStampNotice(samples.back().t, s.t, path, record));
+      continue;
+    }
     samples.push_back(s);
   }
   return samples;
@@ -233,24 +238,30 @@ struct IndexEntry {
 };
 
 // lidar/timestamps.csv (`index,t_start_ns,t_end_ns`) or camera/timestamps.csv (`index,t_ns`).
-std::vector<IndexEntry> readIndex(const fs::path& folder, bool has_end, const char* extension) {
+// Rows whose stamp does not advance are dropped, their warnings appended to `dropped`.
+std::vector<IndexEntry> readIndex(const fs::path& folder, bool has_end, const char* extension,
+                                  std::vector<std::string>& dropped) {
   const std::string csv = (folder / "timestamps.csv").string();
   if (!fs::exists(csv)) fail(csv, "", "timestamps file not found");
   std::vector<IndexEntry> entries;
+  std::size_t listed = 0;  // rows so far, kept or dropped: the index the next row must carry
   for (const NumberedLine& line : readDataLines(csv, "#")) {
     const std::string record = lineRecord(line.number);
     const auto f = splitOn(line.text, ',');
     requireColumns(f, has_end ? 3 : 2, csv, record);
     const std::int64_t index = parseInt64(f[0], csv, record);
-    if (index != static_cast<std::int64_t>(entries.size()))
-      fail(csv, record, "expected index " + std::to_string(entries.size()) + ", found " + std::to_string(index));
+    if (index != static_cast<std::int64_t>(listed))
+      fail(csv, record, "expected index " + std::to_string(listed) + ", found " + std::to_string(index));
     IndexEntry e;
     e.t = parseInt64(f[1], csv, record);
     e.t_end = has_end ? parseInt64(f[2], csv, record) : e.t;
     if (e.t_end < e.t) fail(csv, record, "sweep ends before it starts");
-    if (!entries.empty()) requireIncreasingTime(entries.back().t, e.t, csv, record);
-    e.path = (folder / simFileName(entries.size(), extension)).string();
+    e.path = (folder / simFileName(listed++, extension)).string();
     e.record = "listed in " + csv + " " + record;
+    if (!entries.empty() && e.t <= entries.back().t) {
+      dropped.push_back(staleStampNotice(entries.back().t, e.t, csv, record));
+      continue;
+    }
     entries.push_back(std::move(e));
   }
   return entries;
@@ -268,10 +279,11 @@ LidarScan readScan(const IndexEntry& e, int rings) {
   scan.t = e.t;
   scan.t_end = e.t_end;
   scan.has_time = scan.has_ring = true;
-  scan.points.resize(bytes.size() / kSimPointBytes);
-  for (std::size_t i = 0; i < scan.points.size(); ++i) {
+  const std::size_t n = bytes.size() / kSimPointBytes;
+  scan.points.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const char* r = bytes.data() + i * kSimPointBytes;
-    LidarPoint& p = scan.points[i];
+    LidarPoint p;
     std::uint32_t offset_ns = 0;
     std::memcpy(&p.x, r + 0, 4);
     std::memcpy(&p.y, r + 4, 4);
@@ -280,21 +292,24 @@ LidarScan readScan(const IndexEntry& e, int rings) {
     std::memcpy(&offset_ns, r + 16, 4);
     std::memcpy(&p.ring, r + 20, 2);
     const std::string record = "point " + std::to_string(i);
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.intensity))
-      fail(e.path, record, "non-finite coordinate or intensity");
+    // A missing return, as a real lidar gives: dropped and counted, not an error.
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !std::isfinite(p.intensity)) {
+      ++scan.dropped_nonfinite;
+      continue;
+    }
     if (static_cast<Time>(offset_ns) > e.t_end - e.t)
       fail(e.path, record, "time offset " + std::to_string(offset_ns) + " ns is beyond the sweep's end");
     if (p.ring >= rings)
       fail(e.path, record, "ring " + std::to_string(p.ring) + " >= " + std::to_string(rings) + " rings");
     p.time_offset = static_cast<float>(static_cast<double>(offset_ns) * 1e-9);
+    scan.points.push_back(p);
   }
   return scan;
 }
 
 Image readImage(const IndexEntry& e, const CameraIntrinsics& k, int channels) {
   if (!fs::exists(e.path)) fail(e.path, e.record, "image file not found");
-  cv::Mat mat = cv::imread(e.path, cv::IMREAD_UNCHANGED);
-  if (mat.empty()) fail(e.path, "", "cannot decode image");
+  cv::Mat mat = decodeImageFile(e.path);
   if (mat.depth() != CV_8U || mat.channels() != channels || mat.cols != k.width || mat.rows != k.height)
     fail(e.path, "", "image is " + std::to_string(mat.cols) + "x" + std::to_string(mat.rows) + "x" +
                          std::to_string(mat.channels()) + " (8-bit: " + (mat.depth() == CV_8U ? "yes" : "no") +
@@ -314,9 +329,11 @@ Image readImage(const IndexEntry& e, const CameraIntrinsics& k, int channels) {
 class SimReader final : public Reader {
  public:
   SimReader(fs::path dir, SimDatasetDescription d, GroundTruth gt, std::vector<ImuSample> imu,
-            std::vector<IndexEntry> scans, std::vector<IndexEntry> frames)
+            std::vector<IndexEntry> scans, std::vector<IndexEntry> frames, const std::vector<std::string>& dropped)
       : dir_(std::move(dir)), d_(std::move(d)), gt_(std::move(gt)), imu_(std::move(imu)), scans_(std::move(scans)),
-        frames_(std::move(frames)) {}
+        frames_(std::move(frames)) {
+    for (const std::string& notice : dropped) dropMeasurement(notice);
+  }
 
   std::optional<Measurement> next() override {
     constexpr Time kEnd = std::numeric_limits<Time>::max();
@@ -366,13 +383,14 @@ std::unique_ptr<Reader> openSimDataset(const std::string& dir, const DatasetOpti
   const std::string gt_path = (root / "groundtruth.txt").string();
   if (!fs::exists(gt_path)) fail(gt_path, "", "ground truth file not found");
   GroundTruth gt{readTum(gt_path), "imu"};
+  std::vector<std::string> dropped;  // rows whose stamp does not advance
   std::vector<ImuSample> imu;
-  if (options.load_imu) imu = readImuCsv((root / "imu.csv").string());
+  if (options.load_imu) imu = readImuCsv((root / "imu.csv").string(), dropped);
   std::vector<IndexEntry> scans, frames;
-  if (options.load_lidar) scans = readIndex(root / "lidar", true, ".bin");
-  if (options.load_images) frames = readIndex(root / "camera", false, ".png");
+  if (options.load_lidar) scans = readIndex(root / "lidar", true, ".bin", dropped);
+  if (options.load_images) frames = readIndex(root / "camera", false, ".png", dropped);
   return std::make_unique<SimReader>(root, std::move(d), std::move(gt), std::move(imu), std::move(scans),
-                                     std::move(frames));
+                                     std::move(frames), dropped);
 }
 
 }  // namespace drover::io

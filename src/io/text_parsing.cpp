@@ -190,6 +190,13 @@ void requireIncreasingTime(Time previous, Time t, const std::string& file, const
          "timestamp goes backwards (" + formatSeconds(t) + " s after " + formatSeconds(previous) + " s)");
 }
 
+std::string staleStampNotice(Time previous, Time t, const std::string& file, const std::string& record) {
+  if (t > previous) return "";
+  const std::string where = file + (record.empty() ? "" : " (" + record + ")") + ": dropped: timestamp ";
+  if (t == previous) return where + formatSeconds(t) + " s repeats the previous one";
+  return where + "goes back to " + formatSeconds(t) + " s from " + formatSeconds(previous) + " s";
+}
+
 std::string formatDouble(double value) {
   char buf[64];
   const auto [ptr, ec] = std::to_chars(buf, buf + sizeof(buf), value);

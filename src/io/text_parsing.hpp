@@ -72,6 +72,11 @@ Eigen::Quaterniond checkedQuaternion(double w, double x, double y, double z, con
 // Throws IoError "duplicate timestamp" / "timestamp goes backwards" unless t > previous.
 void requireIncreasingTime(Time previous, Time t, const std::string& file, const std::string& record);
 
+// For sensor streams, which drop a measurement whose stamp does not advance instead of failing: "" when
+// t > previous, else the warning "FILE (RECORD): dropped: timestamp T s repeats the previous one" (or "goes back
+// to T s from P s").
+std::string staleStampNotice(Time previous, Time t, const std::string& file, const std::string& record);
+
 // Shortest text that reads back to exactly the same double (std::to_chars); "nan"/"inf" never reach files
 // because writers validate first.
 std::string formatDouble(double value);

@@ -225,8 +225,11 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
 // Drops bad points and fills in ring/time when the lidar gives none; false when too little is left.
 bool LidarOdometry::Impl::preprocess(LidarScan& scan, ScanOutcome& out) {
   const lidar::SanitizeResult s = lidar::sanitize(scan, config.layout);
-  stats.points_dropped += s.non_finite + s.too_close + s.too_far;
-  if (s.non_finite > 0) out.warning = fmt::format("{} non-finite points dropped", s.non_finite);
+  // Readers drop non-finite points themselves (LidarScan::dropped_nonfinite); sanitize catches any that remain.
+  const std::size_t non_finite = s.non_finite + scan.dropped_nonfinite;
+  stats.points_nonfinite += non_finite;
+  stats.points_dropped += non_finite + s.too_close + s.too_far;
+  if (non_finite > 0) out.warning = fmt::format("{} non-finite points dropped", non_finite);
   out.points = scan.points.size();
   if (static_cast<int>(scan.points.size()) < config.min_points) {
     ++stats.scans_skipped_empty;

@@ -64,7 +64,8 @@ struct OdometryStats {
   std::size_t scans_processed = 0;       // sweeps that produced a pose
   std::size_t scans_skipped_empty = 0;   // too few valid points to match
   std::size_t scans_skipped_time = 0;    // stamp not after the previous sweep's (duplicate or backwards)
-  std::size_t points_dropped = 0;        // non-finite or out-of-range points removed
+  std::size_t points_dropped = 0;        // non-finite or out-of-range points removed (by the reader or sanitize)
+  std::size_t points_nonfinite = 0;      // of which NaN/inf (a warning on each sweep that had any)
   std::size_t keyframes = 0;
   std::size_t degenerate_scans = 0;
   std::size_t not_converged = 0;         // matches that stopped without converging (pose kept from the guess)

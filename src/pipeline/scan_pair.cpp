@@ -11,17 +11,18 @@ namespace drover::pipeline {
 lidar::FeatureSet prepareScan(LidarScan& scan, const OdometryConfig& config, const std::string& name) {
   lidar::sanitize(scan, config.layout);
   if (static_cast<int>(scan.points.size()) < config.min_points)
-    throw std::invalid_argument(fmt::format("{} has {} valid points (fewer than min_points = {})", name,
+    throw std::invalid_argument(fmt::format("{}: {} valid points, fewer than min_points = {}", name,
                                             scan.points.size(), config.min_points));
   if (!scan.has_time) lidar::inferTimes(scan, config.layout);
   if (!scan.has_ring) lidar::inferRings(scan, config.layout);
   return lidar::FeatureExtractor(config.features).extract(scan).features;
 }
 
-ScanPairResult compareScans(LidarScan a, LidarScan b, const OdometryConfig& config) {
+ScanPairResult compareScans(LidarScan a, LidarScan b, const OdometryConfig& config, const std::string& name_a,
+                            const std::string& name_b) {
   ScanPairResult r;
-  const lidar::FeatureSet fa = prepareScan(a, config, "scan A");
-  const lidar::FeatureSet fb = prepareScan(b, config, "scan B");
+  const lidar::FeatureSet fa = prepareScan(a, config, name_a);
+  const lidar::FeatureSet fb = prepareScan(b, config, name_b);
   r.points_a = a.points.size();
   r.points_b = b.points.size();
   const loop::ScanContextConfig& sc = config.loop.database.descriptor;

@@ -29,7 +29,9 @@ struct ScanPairResult {
 lidar::FeatureSet prepareScan(LidarScan& scan, const OdometryConfig& config, const std::string& name = "scan");
 
 // Uses config.layout, config.features, config.loop.database.descriptor and config.loop.verifier. Throws
-// std::invalid_argument when a scan has fewer than config.min_points valid points.
-ScanPairResult compareScans(LidarScan a, LidarScan b, const OdometryConfig& config);
+// std::invalid_argument naming the scan (name_a, name_b: e.g. its file) when it has fewer than config.min_points
+// valid points.
+ScanPairResult compareScans(LidarScan a, LidarScan b, const OdometryConfig& config,
+                            const std::string& name_a = "scan A", const std::string& name_b = "scan B");
 
 }  // namespace drover::pipeline

@@ -1,4 +1,5 @@
 #pragma once
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -21,6 +22,9 @@ struct LidarScan {
   bool has_time = false;    // per-point time_offset is valid: measured by the lidar, or set by lidar::inferTimes()
   bool has_ring = false;    // per-point ring is valid: measured by the lidar, or set by lidar::inferRings()
   std::vector<LidarPoint> points;
+  // Points the reader dropped because a value (coordinate, intensity, time) was NaN or inf: a real lidar's
+  // missing returns. Not in `points`; counted and warned about by whoever consumes the scan.
+  std::size_t dropped_nonfinite = 0;
 };
 
 }  // namespace drover

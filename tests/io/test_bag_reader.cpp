@@ -150,9 +150,10 @@ TEST(BagReader, DropsNanPointsOfOrganisedCloudsAndCountsThem) {
   std::size_t want = 0;
   for (const json& e : expectedTopic("/ouster/points")) want += e["dropped"].get<std::size_t>();
   ASSERT_GT(want, 0u);
-  while (reader.next()) {
-  }
+  std::size_t in_scans = 0;  // what drover run and drover info count
+  while (auto m = reader.next()) in_scans += std::get<LidarScan>(*m).dropped_nonfinite;
   EXPECT_EQ(reader.stats().nonfinite_points_dropped, want);
+  EXPECT_EQ(in_scans, want);
 }
 
 TEST(BagReader, SweepStampedAtItsEndStartsAtTheEarliestPointTime) {
@@ -238,6 +239,25 @@ TEST(BagReader, NamesBagTopicAndMessageOfMalformedMessages) {
           << what;
       EXPECT_NE(what.find(err["contains"].get<std::string>()), std::string::npos) << what;
     }
+  }
+}
+
+TEST(BagReader, DropsAnImuMessageWithARepeatedBackwardsOrNanReadingWithAWarningNamingIt) {
+  const std::string bag = BagFixtures::get().bag("lz4").string();
+  for (const json& drop : BagFixtures::get().expected()["drops"]) {
+    const std::string topic = drop["topic"].get<std::string>();
+    SCOPED_TRACE(topic);
+    BagReader reader(bag, topics("", topic, ""));
+    std::vector<Time> t;
+    while (auto m = reader.next()) t.push_back(measurementTime(*m));
+    EXPECT_EQ(t, drop["kept"].get<std::vector<Time>>());
+    ASSERT_EQ(reader.drops().measurements, 1u);
+    const std::string& notice = reader.drops().notices.at(0);
+    EXPECT_NE(notice.find(bag + " (topic " + topic + " message " + std::to_string(drop["message"].get<int>()) + ","),
+              std::string::npos)
+        << notice;
+    EXPECT_NE(notice.find("dropped"), std::string::npos) << notice;
+    EXPECT_NE(notice.find(drop["contains"].get<std::string>()), std::string::npos) << notice;
   }
 }
 

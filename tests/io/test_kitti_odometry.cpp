@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <fstream>
 #include <sstream>
 
 #include "io/error.hpp"
+#include "io/kitti_common.hpp"
 #include "io/kitti_fixture_util.hpp"
 #include "support/shared_data.hpp"
 #include "support/expect_io_error.hpp"
@@ -243,13 +245,20 @@ TEST(KittiOdometryReader, RejectsBinWhoseSizeIsNotAMultipleOf16) {
   expectIoError([&] { reader.next(); }, {"000000.bin", "not a multiple of 16"});
 }
 
-TEST(KittiOdometryReader, RejectsNanInScan) {
+TEST(KittiOdometryReader, DropsPointsWithANanOrInfValueAndCountsThemInTheScan) {
   TempDir dir;
   const fs::path seq = writeSequence(dir);
-  test::writeBin(seq / "velodyne" / "000001.bin", {{1, 2, 3, 0}, {1, std::nanf(""), 3, 0}});
+  const float inf = std::numeric_limits<float>::infinity();
+  test::writeBin(seq / "velodyne" / "000001.bin",
+                 {{1, 2, 3, 0}, {1, std::nanf(""), 3, 0}, {4, 5, 6, inf}, {7, 8, 9, 0.5f}});
   KittiOdometryReader reader(seq.string(), DatasetOptions{});
   reader.next(), reader.next();
-  expectIoError([&] { reader.next(); }, {"000001.bin", "point 1", "non-finite"});
+  const auto scan = std::get<LidarScan>(*reader.next());
+  ASSERT_EQ(scan.points.size(), 2u);
+  EXPECT_EQ(scan.points[1].x, 7.0f);
+  EXPECT_EQ(scan.points[1].intensity, 0.5f);
+  EXPECT_EQ(scan.dropped_nonfinite, 2u);
+  EXPECT_EQ(reader.drops().measurements, 0u);
 }
 
 TEST(KittiOdometryReader, MissingScanOrImageOfAListedFrameFailsWhenReadNamingTheFrame) {
@@ -305,6 +314,60 @@ TEST(KittiOdometryReader, RejectsMissingOrBackwardsTimesAndMismatchedPoses) {
   fs::remove(seq / "times.txt");
   expectIoError([&] { KittiOdometryReader(seq.string(), DatasetOptions{}); }, {"times.txt", "cannot open"});
   expectIoError([&] { openKittiOdometry((dir / "nowhere").string(), DatasetOptions{}); }, {"not found"});
+}
+
+TEST(KittiOdometryReader, MalformedTrLineIsReportedAsMalformedNotMissing) {
+  TempDir dir;
+  const fs::path seq = writeSequence(dir);
+  writeText(seq / "calib.txt", std::string(kCalib).replace(std::string(kCalib).find("Tr: 0 -1"), 8, "Tr: 0 -x"));
+  expectIoError([&] { KittiOdometryReader(seq.string(), DatasetOptions{}); },
+                {"calib.txt", "(line 5)", "key 'Tr' has a value that is not a number: '-x'"});
+}
+
+TEST(KittiOdometryReader, ZeroFocalLengthOfTheChosenCameraIsAnErrorNamingTheKey) {
+  TempDir dir;
+  const fs::path seq = writeSequence(dir);
+  writeText(seq / "calib.txt", std::string(kCalib).replace(std::string(kCalib).find("P2: 700 0 600 42 0 700"), 22,
+                                                           "P2: 0 0 600 42 0 0"));
+  expectIoError([&] { KittiOdometryReader(seq.string(), DatasetOptions{}); },
+                {"calib.txt", "(line 3)", "key 'P2': focal lengths must be > 0 px, got fx 0, fy 0"});
+}
+
+TEST(KittiOdometryReader, ImageOfAnotherSizeThanFrameZerosIsAnErrorNamingTheFile) {
+  TempDir dir;
+  const fs::path seq = writeSequence(dir);
+  test::writePng(seq / "image_2" / "000001.png", 1, 1, 3, {1, 2, 3});
+  DatasetOptions options;
+  options.load_lidar = false;
+  KittiOdometryReader reader(seq.string(), options);
+  reader.next();
+  expectIoError([&] { reader.next(); }, {"000001.png", "(frame 1)", "image is 1x1 px, frame 0's is 2x1"});
+}
+
+TEST(KittiOdometryReader, PngHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
+  TempDir dir;
+  const fs::path seq = writeSequence(dir);
+  // A valid 2x1 PNG whose IHDR then claims 100000 x 100000 px (the CRC no longer matches: OpenCV is never asked).
+  std::string png = test::readText(seq / "image_2" / "000001.png");
+  const unsigned char huge[8] = {0, 1, 0x86, 0xa0, 0, 1, 0x86, 0xa0};  // 100000 big-endian, twice
+  png.replace(16, 8, reinterpret_cast<const char*>(huge), 8);
+  writeText(seq / "image_2" / "000001.png", png);
+  DatasetOptions options;
+  options.load_lidar = false;
+  KittiOdometryReader reader(seq.string(), options);
+  reader.next();
+  expectIoError([&] { reader.next(); }, {"000001.png", "(header)", "header claims 100000x100000 px"});
+}
+
+TEST(KittiScanText, DropsLinesWithNanOrInfAndCountsThem) {
+  TempDir dir;
+  writeText(dir / "scan.txt", "1 2 3 0.5\nnan 2 3 0.5\n4 5 6 -inf\n7 8 9 1e300\n10 11 12 0\n");
+  const LidarScan scan = readKittiScanText((dir / "scan.txt").string(), 0, 0);
+  ASSERT_EQ(scan.points.size(), 2u);
+  EXPECT_EQ(scan.points[1].x, 10.0f);
+  EXPECT_EQ(scan.dropped_nonfinite, 3u);
+  writeText(dir / "scan.txt", "1 2 3 0.5\n1 2 x 0.5\n");
+  expectIoError([&] { readKittiScanText((dir / "scan.txt").string(), 0, 0); }, {"scan.txt", "line 2"});
 }
 
 }  // namespace

@@ -272,7 +272,7 @@ TEST(SimDatasetReader, ScanFileSizeNotAMultipleOfTheRecordIsNamed) {
   expectIoError([&] { readAll(dir); }, {"000001.bin", "not a multiple of the 24-byte"});
 }
 
-TEST(SimDatasetReader, NanPointIsNamedByFileAndPoint) {
+TEST(SimDatasetReader, NanPointIsDroppedAndCountedInItsScan) {
   TempDir tmp;
   const fs::path dir = writeDataset(tmp);
   std::fstream f(dir / "lidar" / "000002.bin", std::ios::binary | std::ios::in | std::ios::out);
@@ -280,7 +280,16 @@ TEST(SimDatasetReader, NanPointIsNamedByFileAndPoint) {
   f.seekp(3 * 24 + 4);  // point 3, y
   f.write(reinterpret_cast<const char*>(&nan), 4);
   f.close();
-  expectIoError([&] { readAll(dir); }, {"000002.bin", "point 3", "non-finite"});
+  const auto reader = openSimDataset(dir.string(), {});
+  std::size_t points = 0, dropped = 0;
+  while (auto m = reader->next()) {
+    if (const auto* scan = std::get_if<LidarScan>(&*m)) {
+      points += scan->points.size();
+      dropped += scan->dropped_nonfinite;
+    }
+  }
+  EXPECT_EQ(dropped, 1u);
+  EXPECT_GT(points, 0u);
 }
 
 TEST(SimDatasetReader, NanInImuCsvIsNamedByLine) {
@@ -294,18 +303,32 @@ TEST(SimDatasetReader, NanInImuCsvIsNamedByLine) {
   expectIoError([&] { openSimDataset(dir.string(), {}); }, {"imu.csv", "line 4"});
 }
 
-TEST(SimDatasetReader, ImuTimeGoingBackwardsIsNamedByLine) {
+TEST(SimDatasetReader, ImuSampleWhoseTimeGoesBackwardsIsDroppedWithAWarningNamingTheLine) {
   TempDir tmp;
   const fs::path dir = writeDataset(tmp);
   replaceInFile(dir / "imu.csv", "\n30,", "\n15,");
-  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"imu.csv", "line 5", "backwards"});
+  const auto reader = openSimDataset(dir.string(), {});
+  ASSERT_EQ(reader->drops().measurements, 1u);
+  EXPECT_NE(reader->drops().notices.at(0).find("imu.csv (line 5): dropped: timestamp goes back"), std::string::npos)
+      << reader->drops().notices.at(0);
 }
 
-TEST(SimDatasetReader, LidarTimeGoingBackwardsIsNamedByLine) {
+TEST(SimDatasetReader, ScanWhoseTimeGoesBackwardsIsDroppedAndTheNextScanIsStillItsOwnFile) {
   TempDir tmp;
   const fs::path dir = writeDataset(tmp);
-  replaceInFile(dir / "lidar" / "timestamps.csv", "2,200,", "2,50,");
-  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"timestamps.csv", "line 4", "backwards"});
+  replaceInFile(dir / "lidar" / "timestamps.csv", "1,100,", "1,0,");
+  // Were scan 2 read from scan 1's file, this would fail the read.
+  std::ofstream(dir / "lidar" / "000001.bin", std::ios::binary | std::ios::app) << "xyz";
+  DatasetOptions options;
+  options.load_imu = options.load_images = false;
+  const auto reader = openSimDataset(dir.string(), options);
+  std::vector<Time> t;
+  while (auto m = reader->next()) t.push_back(std::get<LidarScan>(*m).t);
+  EXPECT_EQ(t, (std::vector<Time>{0, 200}));
+  ASSERT_EQ(reader->drops().measurements, 1u);
+  EXPECT_NE(reader->drops().notices.at(0).find("timestamps.csv (line 3): dropped: timestamp 0.000000000 s repeats"),
+            std::string::npos)
+      << reader->drops().notices.at(0);
 }
 
 TEST(SimDatasetReader, MissingScanFileIsNamed) {
