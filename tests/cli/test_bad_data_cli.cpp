@@ -105,6 +105,31 @@ TEST(BadDataCli, InfoDropsAnImuRowWhoseStampRepeatsWithAWarningNamingTheLineAndC
   EXPECT_EQ(readJson(dir / "info.json")["measurements_dropped"].get<int>(), 1);
 }
 
+TEST(BadDataCli, RunOnASimulatedDatasetDropsARepeatedScanStampAndANanPointWithWarningsAndCountsThem) {
+  TempDir dir;
+  const fs::path sim = dir / "sim";
+  ASSERT_EQ(runDrover("sim -q --scenario straight --duration 1.5 --no-camera --out " + sim.string()).exit_code, 0);
+  std::string index = readText(sim / "lidar" / "timestamps.csv");
+  const std::size_t row = index.find("\n2,200000000,") + 1;
+  index.replace(row, 11, "2,100000000");  // scan 2 repeats scan 1's stamp
+  writeText(sim / "lidar" / "timestamps.csv", index);
+  {
+    std::fstream f(sim / "lidar" / "000004.bin", std::ios::binary | std::ios::in | std::ios::out);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    f.write(reinterpret_cast<const char*>(&nan), 4);  // point 0's x
+  }
+  const CliResult r = runDrover("run " + sim.string() + " --format sim --no-loop --config " DROVER_SOURCE_DIR
+                                "/config/farm_sim.yaml --out " + (dir / "run").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "[warning] " + (sim / "lidar" / "timestamps.csv").string() +
+                                     " (line 4): dropped: timestamp 0.100000000 s repeats the previous one"))
+      << r.output;
+  EXPECT_TRUE(contains(r.output, ": 1 non-finite points dropped")) << r.output;
+  const nlohmann::json counts = readJson(dir / "run" / "report.json")["counts"];
+  EXPECT_EQ(counts["measurements_dropped"].get<int>(), 1);
+  EXPECT_EQ(counts["points_nonfinite"].get<int>(), 1);
+}
+
 TEST(BadDataCli, BagFormatOnAFolderSaysItIsAFolder) {
   TempDir dir;
   const CliResult r = runDrover("info " + dir.path().string() + " --format bag");
@@ -140,6 +165,20 @@ TEST(BadDataCli, LoopPairOnAnEmptyScanNamesTheScan) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_TRUE(contains(r.output, "[error] " + (dir / "empty.bin").string() + ": 0 valid points, fewer than min_points"))
       << r.output;
+}
+
+TEST(BadDataCli, PngWhoseHeaderClaimsAHugeImageIsRefusedNamingTheFileNotWithOpenCvsAssertion) {
+  TempDir dir;
+  // Signature and an IHDR claiming 100000 x 100000 px, 8-bit grey; nothing after it is needed.
+  const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 13, 'I', 'H', 'D', 'R',
+                               0, 1, 0x86, 0xa0, 0, 1, 0x86, 0xa0, 8, 0, 0, 0, 0, 0, 0, 0, 0};
+  std::ofstream(dir / "huge.png", std::ios::binary).write(reinterpret_cast<const char*>(png), sizeof(png));
+  const CliResult r = runDrover("features detect " + (dir / "huge.png").string() + " --detector orb");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "[error] " + (dir / "huge.png").string() +
+                                     " (header): header claims 100000x100000 px, more than"))
+      << r.output;
+  EXPECT_FALSE(contains(r.output, "CV_IO_MAX_IMAGE_PIXELS")) << r.output;
 }
 
 TEST(BadDataCli, InfoRefusesAZeroFocalLengthNamingTheCalibLine) {

@@ -199,17 +199,22 @@ TEST(LidarOdometry, ReplayIsDeterministic) {
     EXPECT_TRUE(a.imu_poses[i].T_world_body.isApprox(b.imu_poses[i].T_world_body, 0.0)) << i;
 }
 
-TEST(LidarOdometry, NonFinitePointsAreDroppedAndCounted) {
+TEST(LidarOdometry, NonFinitePointsAreDroppedAndCountedWithThoseTheReaderDropped) {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  std::size_t edited_scans = 0;
   const OdometryRun r = runOn(edited([&](Measurement& m) {
                         if (auto* s = std::get_if<LidarScan>(&m); s && s->points.size() > 10) {
                           s->points[3].x = nan;
                           s->points[7].z = inf;
+                          s->dropped_nonfinite = 5;  // as a reader reports the NaN points it left out
+                          ++edited_scans;
                         }
                         return true;
                       }),
                       simConfig(true));
-  EXPECT_GE(r.stats.points_dropped, 2 * sweeps());
+  ASSERT_EQ(edited_scans, sweeps());
+  EXPECT_EQ(r.stats.points_nonfinite, 7 * edited_scans);
+  EXPECT_GE(r.stats.points_dropped, 7 * sweeps());
   EXPECT_EQ(r.imu_poses.size(), sweeps());
   EXPECT_LT(r.ape_rmse, 0.05);
 }
