@@ -102,8 +102,12 @@ BagFile::BagFile(std::string path) : path_(std::move(path)), in_(path_, std::ios
   if (size_ < kMagicLen) fail(path_, "", "file is too short to be a ROS bag");
   read(0, magic, kMagicLen, "magic line");
   if (std::memcmp(magic, kMagic, kMagicLen) != 0) {
-    if (std::memcmp(magic, "#ROSBAG V", 9) == 0)
-      fail(path_, "", "unsupported bag version '" + std::string(magic, kMagicLen - 1) + "' (only 2.0 is supported)");
+    if (std::memcmp(magic, "#ROSBAG V", 9) == 0) {
+      std::string version(magic, kMagicLen - 1);  // shown on one line, whatever bytes it holds
+      for (char& c : version)
+        if (c < 0x20 || c > 0x7e) c = '?';
+      fail(path_, "", "unsupported bag version '" + version + "' (only 2.0 is supported)");
+    }
     fail(path_, "", "not a ROS bag: the file does not start with '#ROSBAG V2.0'");
   }
 }

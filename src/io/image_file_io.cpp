@@ -68,8 +68,8 @@ std::string imageHeaderProblem(const unsigned char* data, std::size_t size) {
   if (!wh) return "";
   const auto [w, h] = *wh;
   const std::string claim = "header claims " + std::to_string(w) + "x" + std::to_string(h) + " px";
-  if (w <= 0 || h <= 0) return claim;
-  if (w * h > kMaxImagePixels)
+  if (w <= 0 || h <= 0) return claim + ", an empty image";
+  if (w > kMaxImagePixels / h)  // w * h > the limit, without overflowing for 32-bit sizes
     return claim + ", more than the " + std::to_string(kMaxImagePixels) + " px an image may have";
   return "";
 }

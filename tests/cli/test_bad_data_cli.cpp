@@ -179,6 +179,13 @@ TEST(BadDataCli, PngWhoseHeaderClaimsAHugeImageIsRefusedNamingTheFileNotWithOpen
                                      " (header): header claims 100000x100000 px, more than"))
       << r.output;
   EXPECT_FALSE(contains(r.output, "CV_IO_MAX_IMAGE_PIXELS")) << r.output;
+  // A JPEG whose frame header (SOF0, after an APP0 segment) claims 60000 x 50000 px.
+  const unsigned char jpeg[] = {0xff, 0xd8, 0xff, 0xe0, 0, 4, 'J', 'F', 0xff, 0xc0, 0, 17, 8, 0xc3, 0x50, 0xea, 0x60,
+                                1, 1, 0x11, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+  std::ofstream(dir / "huge.jpg", std::ios::binary).write(reinterpret_cast<const char*>(jpeg), sizeof(jpeg));
+  const CliResult j = runDrover("features detect " + (dir / "huge.jpg").string() + " --detector orb");
+  EXPECT_EQ(j.exit_code, 2) << j.output;
+  EXPECT_TRUE(contains(j.output, "huge.jpg (header): header claims 60000x50000 px, more than")) << j.output;
 }
 
 TEST(BadDataCli, InfoRefusesAZeroFocalLengthNamingTheCalibLine) {

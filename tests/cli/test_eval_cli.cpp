@@ -195,7 +195,8 @@ TEST(EvalCli, TooFewMatchesExitWithCodeTwo) {
   writeText(dir / "two.txt", tumLine(100.0, 0, 0, 0) + tumLine(100.1, 1, 0, 0));
   r = runDrover("eval ape " + late.ref.string() + " " + (dir / "two.txt").string() + " --align se3");
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_TRUE(contains(r.output, "degenerate")) << r.output;
+  EXPECT_TRUE(contains(r.output, "two.txt (against ")) << r.output;
+  EXPECT_TRUE(contains(r.output, "cannot align (se3): the 2 matched positions are all equal or on one line")) << r.output;
 }
 
 TEST(EvalCli, KittiRejectsUnequalCountsAndShortTrajectories) {

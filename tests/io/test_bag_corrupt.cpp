@@ -85,6 +85,8 @@ TEST_F(CorruptBag, RejectsAnotherMagicLine) {
   b.replace(0, 13, "#ROSBOG V2.0\n");
   expectError(b, "not a ROS bag");
   expectError("#ROS", "too short");
+  b.replace(0, 13, "#ROSBAG V\n2.0");  // the version is shown on the error's one line
+  expectError(b, "unsupported bag version '#ROSBAG V?2.' (only 2.0");
 }
 
 TEST_F(CorruptBag, RejectsBagCutInTheMiddleOfAChunk) {

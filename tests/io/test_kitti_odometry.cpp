@@ -357,6 +357,12 @@ TEST(KittiOdometryReader, PngHeaderClaimingAHugeImageIsRefusedBeforeDecoding) {
   KittiOdometryReader reader(seq.string(), options);
   reader.next();
   expectIoError([&] { reader.next(); }, {"000001.png", "(header)", "header claims 100000x100000 px"});
+  // The largest sizes a PNG header can hold: their product must not overflow into an acceptable number.
+  png.replace(16, 8, std::string(8, '\xff'));
+  writeText(seq / "image_2" / "000001.png", png);
+  KittiOdometryReader again(seq.string(), options);
+  again.next();
+  expectIoError([&] { again.next(); }, {"000001.png", "(header)", "header claims 4294967295x4294967295 px"});
 }
 
 TEST(KittiScanText, DropsLinesWithNanOrInfAndCountsThem) {
