@@ -97,7 +97,9 @@ CameraIntrinsics readIntrinsics(const YAML::Node& root, const std::string& file)
   cam.height = static_cast<int>(wh[1]);
   const YAML::Node intr = requireKey(root, "intrinsics", file);
   const std::vector<double> k = numberList(intr, 4, "intrinsics", file);  // fu fv cu cv [px]
-  if (k[0] <= 0 || k[1] <= 0) fail(file, keyRecord(intr, "intrinsics"), "focal lengths must be positive");
+  if (!(k[0] > 0) || !(k[1] > 0))
+    fail(file, keyRecord(intr, "intrinsics"),
+         "focal lengths must be > 0 px, got fx " + formatDouble(k[0]) + ", fy " + formatDouble(k[1]));
   cam.fx = k[0], cam.fy = k[1], cam.cx = k[2], cam.cy = k[3];
   cam.distortion = parseDistortionModel(requireKey(root, "distortion_model", file), file);
   const YAML::Node coeffs = requireKey(root, "distortion_coefficients", file);

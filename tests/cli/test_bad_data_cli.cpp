@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "io/fixtures/bag_fixtures.hpp"
 #include "support/cli.hpp"
 #include "support/shared_data.hpp"
 #include "support/temp_dir.hpp"
@@ -186,6 +187,28 @@ TEST(BadDataCli, PngWhoseHeaderClaimsAHugeImageIsRefusedNamingTheFileNotWithOpen
   const CliResult j = runDrover("features detect " + (dir / "huge.jpg").string() + " --detector orb");
   EXPECT_EQ(j.exit_code, 2) << j.output;
   EXPECT_TRUE(contains(j.output, "huge.jpg (header): header claims 60000x50000 px, more than")) << j.output;
+}
+
+TEST(BadDataCli, FeaturesTrackOnAnImageOfAnotherSizeThanTheCalibrationNamesTheImage) {
+  TempDir dir;
+  // The fixture bag's /cam/png images are 7x5 px; the config says 8x5.
+  writeText(dir / "cfg.yaml", R"(dataset:
+  image_topic: /cam/png
+  load_lidar: false
+  load_imu: false
+calibration:
+  T_imu_lidar: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+  T_imu_cam: [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]
+  camera: {width: 8, height: 5, fx: 5, fy: 5, cx: 3, cy: 2, distortion_model: none, distortion_coeffs: []}
+  lidar_time_offset: 0
+  camera_time_offset: 0
+)");
+  const std::string bag = BagFixtures::get().bag("none").string();
+  const CliResult r = runDrover("features track " + bag + " --format bag --detector orb --config " +
+                                (dir / "cfg.yaml").string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "[error] " + bag + ":/cam/png#0: image is 7x5 px but the camera calibration says 8x5"))
+      << r.output;
 }
 
 TEST(BadDataCli, InfoRefusesAZeroFocalLengthNamingTheCalibLine) {

@@ -239,6 +239,19 @@ TEST_F(EurocFixture, RejectsAnImuLineWithSixColumns) {
   EXPECT_TRUE(contains(msg, "expected 7 columns, found 6")) << msg;
 }
 
+TEST_F(EurocFixture, RejectsAZeroOrNonFiniteFocalLengthNamingTheKey) {
+  std::string cam = kCamYaml;
+  cam.replace(cam.find("intrinsics: [100.0"), 18, "intrinsics: [0.0");
+  write("mav0/cam0/sensor.yaml", cam);
+  std::string msg = errorOf();
+  EXPECT_TRUE(contains(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
+  EXPECT_TRUE(contains(msg, "focal lengths must be > 0 px, got fx 0, fy 101")) << msg;
+  cam.replace(cam.find("intrinsics: [0.0"), 16, "intrinsics: [.nan");
+  write("mav0/cam0/sensor.yaml", cam);
+  msg = errorOf();
+  EXPECT_TRUE(contains(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
+}
+
 TEST_F(EurocFixture, RejectsNanInAnImuLine) {
   write("mav0/imu0/data.csv", "1000,0.1,nan,0.3,1.0,2.0,9.81\n");
   const std::string msg = errorOf();
