@@ -1,6 +1,7 @@
 // drover features track: KLT tracking over a dataset's camera frames with a chosen detector; writes tracks.json
 // (per frame and summary) and overlay PNGs.
 #include <fmt/core.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <filesystem>
@@ -115,6 +116,8 @@ void runTrack(const TrackOptions& o) {
                      visual::drawTracks(image, r, camera.intrinsics().fx));
     ++index;
   }
+  if (!o.quiet)
+    for (const std::string& notice : reader->drops().notices) spdlog::warn("{}", notice);
   if (index == 0) throw std::runtime_error(o.dataset + ": no camera frames (in the --start/--duration window)");
   const visual::TrackingSummary s = summary.summary();
   const Json j{{"dataset", o.dataset},

@@ -211,6 +211,34 @@ calibration:
       << r.output;
 }
 
+TEST(BadDataCli, FeaturesTrackWarnsAboutAnImageWhoseStampRepeats) {
+  const fs::path euroc = sharedData("euroc/V1_01_easy_micro");
+  DROVER_REQUIRE_SHARED(euroc);
+  TempDir dir;
+  const fs::path mav0 = dir / "seq" / "mav0";
+  fs::create_directories(mav0 / "imu0");
+  fs::create_directories(mav0 / "cam0" / "data");
+  fs::copy_file(euroc / "mav0" / "imu0" / "sensor.yaml", mav0 / "imu0" / "sensor.yaml");
+  fs::copy_file(euroc / "mav0" / "cam0" / "sensor.yaml", mav0 / "cam0" / "sensor.yaml");
+  writeText(mav0 / "imu0" / "data.csv", "1,0,0,0,0,0,9.8\n");
+  std::ifstream rows(euroc / "mav0" / "cam0" / "data.csv");
+  std::string header, line, csv;
+  std::getline(rows, header);
+  for (int i = 0; i < 3 && std::getline(rows, line); ++i) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string name = line.substr(line.find(',') + 1);
+    fs::copy_file(euroc / "mav0" / "cam0" / "data" / name, mav0 / "cam0" / "data" / name);
+    csv += line + "\n";
+    if (i == 1) csv += line + "\n";  // line 4 repeats line 3
+  }
+  writeText(mav0 / "cam0" / "data.csv", header + "\n" + csv);
+  const CliResult r = runDrover("features track " + (dir / "seq").string() + " --format euroc --detector orb --out " +
+                                (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(contains(r.output, "[warning] " + (mav0 / "cam0" / "data.csv").string() + " (line 4): dropped: timestamp"))
+      << r.output;
+}
+
 TEST(BadDataCli, InfoRefusesAZeroFocalLengthNamingTheCalibLine) {
   DROVER_REQUIRE_SHARED(kKitti00);
   TempDir dir;
