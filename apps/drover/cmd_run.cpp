@@ -81,6 +81,45 @@ void keep(std::vector<pipeline::ScanOutcome>&& outcomes, RunRecord& record) {
   }
 }
 
+// What the run actually fuses, said once the first sweep has decided it (the IMU is initialised at that sweep,
+// or given up: an empty IMU file, or data that starts too late, means lidar only -- a warning when it was asked for).
+void announceFusion(const pipeline::LidarOdometry& odometry, const RunOptions& o) {
+  const pipeline::OdometryStats& s = odometry.stats();
+  const std::string loop = odometry.config().loop.enabled ? ", loop closure" : "";
+  if (!odometry.config().use_imu)
+    spdlog::info("fusing: lidar only{} ({})", loop, o.no_imu ? "--no-imu" : "odometry.use_imu is false");
+  else if (s.imu_initialized)
+    spdlog::info("fusing: lidar + IMU{}; IMU {}", loop, s.imu_init);
+  else if (s.imu.accepted == 0)
+    spdlog::warn("fusing: lidar only{}: the dataset gave no IMU sample{}", loop,
+                 o.format == "kitti" ? " (KITTI odometry has no IMU)" : " (is its IMU file or topic empty?)");
+  else
+    spdlog::warn("fusing: lidar only{}: {}", loop, s.imu_init);
+}
+
+// Prints the odometry's new notices (skipped sweeps, IMU problems) and, at the first pose, what is fused.
+void showNotices(const pipeline::LidarOdometry& odometry, const RunOptions& o, RunRecord& record) {
+  const std::vector<std::string>& notices = odometry.stats().notices;
+  for (; record.notices_shown < notices.size(); ++record.notices_shown) spdlog::warn("{}", notices[record.notices_shown]);
+  if (!record.fusion_announced && odometry.stats().scans_processed > 0) {
+    announceFusion(odometry, o);
+    record.fusion_announced = true;
+  }
+}
+
+// A run in which no sweep produced a pose is a failure with its reason, not an empty success.
+void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o) {
+  const std::string window = o.start > 0 || o.duration > 0 ? " in the --start/--duration window" : "";
+  if (s.scans_in == 0)
+    throw std::invalid_argument("dataset " + o.dataset + " has no lidar scans" + window +
+                                ": drover run needs a lidar (the visual-inertial subsystem is not built yet)");
+  if (s.scans_processed == 0)
+    throw std::invalid_argument(fmt::format(
+        "{}: no sweep produced a pose{}: of {} sweeps, {} had too few valid points (odometry.min_points) and {} a "
+        "stamp not after the previous sweep's; {} points were dropped as non-finite or out of range",
+        o.dataset, window, s.scans_in, s.scans_skipped_empty, s.scans_skipped_time, s.points_dropped));
+}
+
 void runOdometry(const RunOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
   checkOptions(o);
@@ -90,8 +129,7 @@ void runOdometry(const RunOptions& o) {
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, datasetOptions(o));
   const io::GroundTruth& gt = reader->groundTruth();
   pipeline::LidarOdometry odometry(config, reader->calibration());
-  spdlog::info("drover run: {} ({}), {}{} -> {}", reader->describe(), o.format,
-               config.use_imu ? "lidar + IMU" : "lidar only", config.loop.enabled ? ", loop closure" : "", o.out);
+  spdlog::info("drover run: {} ({}) -> {}", reader->describe(), o.format, o.out);
 
   const double gt_span = gt.poses.size() > 1 ? toSeconds(gt.poses.back().t - gt.poses.front().t) : 0.0;
   const double total = o.duration > 0 ? (gt_span > 0 ? std::min(o.duration, gt_span - o.start) : o.duration)
@@ -111,20 +149,18 @@ void runOdometry(const RunOptions& o) {
       record.end = "--duration reached";
       break;
     }
+    if (const auto* scan = std::get_if<LidarScan>(&*m))
+      record.scan_times.push_back(scan->t + reader->calibration().lidar_time_offset);
     keep(odometry.process(*m), record);
-    const std::vector<std::string>& notices = odometry.stats().notices;
-    for (; record.notices_shown < notices.size(); ++record.notices_shown)
-      spdlog::warn("{}", notices[record.notices_shown]);
+    showNotices(odometry, o, record);
     progress.update(record.scans.size(), since - o.start);
   }
   if (o.max_frames > 0 && o.format == "kitti" && scans_read >= o.max_frames) record.end = "--max-frames reached";
   const int interrupted_by = stop.signal();  // a signal after the reading is done changes nothing
   if (interrupted_by) record.end = "interrupted by " + signalName(interrupted_by);
   keep(odometry.finish(), record);
-  if (odometry.stats().scans_in == 0)
-    throw std::invalid_argument("dataset " + o.dataset + " has no lidar scans" +
-                                (o.start > 0 || o.duration > 0 ? " in the --start/--duration window" : "") +
-                                ": drover run needs a lidar (the visual-inertial subsystem is not built yet)");
+  showNotices(odometry, o, record);
+  checkSomethingWasDone(odometry.stats(), o);
   record.wall_s = progress.wallSeconds();
   record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
   // Only now, and as OUT.partial: a run that fails on its data leaves no folder behind, one killed while writing

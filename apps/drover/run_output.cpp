@@ -10,6 +10,7 @@
 #include "apps/drover/eval_report.hpp"
 #include "apps/drover/loop_report.hpp"
 #include "eval/ape.hpp"
+#include "geometry/trajectory_fill.hpp"
 #include "io/cloud_io.hpp"
 #include "io/kitti_common.hpp"
 #include "io/trajectory_io.hpp"
@@ -39,15 +40,31 @@ Trajectory imuRateInBodyFrame(const Trajectory& imu, const RunContext& c) {
   return out;
 }
 
-// KITTI devkit frame: T_cam0(0)_cam0(i) = Tr T_lidar0_lidar_i Tr^-1 with Tr = T_cam0_lidar from calib.txt.
-void writeKittiTrajectory(const RunContext& c, const Trajectory& lidar) {
-  if (c.format != "kitti" || lidar.empty()) return;
+// KITTI devkit frame: T_cam0(0)_cam0(i) = Tr T_lidar0_lidar_i Tr^-1 with Tr = T_cam0_lidar from calib.txt. One line
+// per scan read, as poses.txt and the devkit match by line: a sweep the odometry skipped gets the pose interpolated
+// between its neighbours (extrapolated at the ends), with a warning; the JSON lists those scans (index, how).
+Json writeKittiTrajectory(const RunContext& c, const Trajectory& lidar, const RunRecord& r) {
+  if (c.format != "kitti" || lidar.empty()) return nullptr;
   const io::KittiCalibFile calib((fs::path(c.dataset) / "calib.txt").string());
   const Eigen::Isometry3d Tr = calib.rigid34("Tr");
-  const Eigen::Isometry3d T_lidar0_world = lidar.front().T_world_body.inverse();
-  Trajectory cam = lidar;
-  for (auto& p : cam) p.T_world_body = Tr * (T_lidar0_world * p.T_world_body) * Tr.inverse();
+  const std::vector<geometry::FilledPose> filled = geometry::posesAtTimes(lidar, r.scan_times);
+  const Eigen::Isometry3d T_lidar0_world = filled.front().pose.T_world_body.inverse();
+  Trajectory cam;
+  Json fills = Json::array();
+  std::string listed;
+  for (std::size_t i = 0; i < filled.size(); ++i) {
+    const geometry::FilledPose& f = filled[i];
+    cam.push_back({f.pose.t, Tr * (T_lidar0_world * f.pose.T_world_body) * Tr.inverse()});
+    if (f.kind == geometry::FillKind::kEstimated) continue;
+    fills.push_back({{"line", i}, {"t", toSeconds(f.pose.t)}, {"pose", geometry::toString(f.kind)}});
+    if (fills.size() <= 10) listed += fmt::format("{}{} ({})", listed.empty() ? "" : ", ", i, geometry::toString(f.kind));
+  }
   io::writeKitti(inRun(c, "trajectory_kitti.txt"), cam);
+  if (!fills.empty())
+    spdlog::warn("trajectory_kitti.txt: {} of {} scans had no pose of their own (skipped sweeps); their lines "
+                 "(0-based) hold a pose from their neighbours: {}{}",
+                 fills.size(), filled.size(), listed, fills.size() > 10 ? ", ..." : "");
+  return {{"lines", filled.size()}, {"filled", fills}};
 }
 
 struct StageSummary {
@@ -196,7 +213,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
     io::writeTum(inRun(c, "trajectory.tum"), est);
     io::writeTum(inRun(c, "keyframes.tum"), inBodyFrame(odometry.keyframeTrajectory(), c));
   }
-  writeKittiTrajectory(c, odometry.trajectory());
+  const Json kitti = writeKittiTrajectory(c, odometry.trajectory(), r);
   const Trajectory imu_rate = imuRateInBodyFrame(odometry.imuRateTrajectory(), c);
   if (!imu_rate.empty()) io::writeTum(inRun(c, "trajectory_imu_rate.tum"), imu_rate);
   const lidar::PointCloud map = odometry.mapCloud(kMapLeaf);
@@ -208,7 +225,8 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["dataset"] = c.dataset;
   report["format"] = c.format;
   report["config"] = c.config;
-  report["mode"] = odometry.config().use_imu ? "lidar+imu" : "lidar";
+  report["mode"] = s.imu_initialized ? "lidar+imu" : "lidar";  // what was fused (the IMU may have been given up)
+  report["imu_requested"] = odometry.config().use_imu;
   report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};
   report["body_frame"] = c.ground_truth.body_frame.empty() ? "lidar" : c.ground_truth.body_frame;
   report["wall_s"] = r.wall_s;
@@ -220,6 +238,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["ape"] = evaluate(c, est);
   report["loops"] = loopsJson(c, odometry);
   if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
+  if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
   report["scans"] = scansJson(r);
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",

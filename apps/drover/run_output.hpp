@@ -2,7 +2,8 @@
 // What `drover run` writes into its run folder (names that scripts rely on):
 //   trajectory.tum        one pose per sweep, T_world_body with body = the ground truth's body frame (the IMU for
 //                         simulated and IMU datasets, the lidar for KITTI odometry), TUM format
-//   trajectory_kitti.txt  KITTI odometry only: one line per sweep, camera-0 frame, first pose identity
+//   trajectory_kitti.txt  KITTI odometry only: one line per scan read (a skipped sweep gets a pose interpolated
+//                         between its neighbours, or extrapolated at the ends), camera-0 frame, first pose identity
 //   keyframes.tum         the keyframes' poses, same frame as trajectory.tum
 //   trajectory_imu_rate.tum  with the IMU: the IMU-rate odometry (the fused state propagated to each IMU sample as
 //                         it arrives), same frame as trajectory.tum
@@ -26,9 +27,11 @@ struct RunContext {
 
 struct RunRecord {
   std::vector<pipeline::ScanOutcome> scans;
+  std::vector<Time> scan_times;  // [ns] every sweep handed to the odometry, on the IMU clock (as trajectory times)
   double wall_s = 0;  // [s] wall time of the odometry loop (reading included)
   double data_s = 0;  // [s] time spanned by the processed sweeps
   std::size_t notices_shown = 0;  // OdometryStats::notices already printed
+  bool fusion_announced = false;  // the "fusing: ..." line was printed
   // Why the run stopped (report.json "end"): "end of data", "--duration reached", "--max-frames reached" or
   // "interrupted by SIGINT" / "SIGTERM".
   std::string end = "end of data";

@@ -38,7 +38,7 @@ ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_im
       initializer_(config.initializer),
       smoother_(config.smoother) {}
 
-void ImuFusion::addImu(const ImuSample& sample) { propagator_.addSample(sample); }
+imu::SampleStatus ImuFusion::addImu(const ImuSample& sample) { return propagator_.addSample(sample); }
 
 bool ImuFusion::wantsImu() const { return config_.use_imu && !given_up_ && propagator_.stats().accepted > 0; }
 

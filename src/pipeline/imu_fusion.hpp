@@ -24,7 +24,8 @@ class ImuFusion {
   // T_imu_lidar: the lidar's pose on the IMU (body).
   ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_imu_lidar);
 
-  void addImu(const ImuSample& sample);
+  // Checks and buffers one sample; the status says whether it was accepted (and after a gap) or dropped.
+  imu::SampleStatus addImu(const ImuSample& sample);
   // True when sweeps should wait for IMU data: the IMU is enabled, has produced samples and was not given up.
   bool wantsImu() const;
   Time latestImuTime() const { return propagator_.latestTime(); }

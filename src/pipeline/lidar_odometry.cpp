@@ -10,6 +10,7 @@
 #include "lidar/deskew.hpp"
 #include "lidar/voxel_filter.hpp"
 #include "pipeline/imu_fusion.hpp"
+#include "pipeline/imu_stream_notices.hpp"
 #include "pipeline/motion_models.hpp"
 
 namespace drover::pipeline {
@@ -32,6 +33,8 @@ struct LidarOdometry::Impl {
   lidar::ScanMatcher matcher;
   lidar::KeyframePolicy policy;
   ImuFusion fusion;
+  ImuStreamNotices imu_notices;
+  std::optional<Time> last_imu;   // [ns] stamp of the newest accepted IMU sample
   std::deque<LidarScan> pending;  // sweeps waiting for the IMU to cover their end (time order)
   Trajectory trajectory;          // T_world_lidar per processed sweep
   Trajectory imu_rate;            // T_world_imu per IMU sample after initialisation (imuRateTrajectory())
@@ -69,6 +72,11 @@ struct LidarOdometry::Impl {
                                      ScanOutcome& out) const;
   void match(const lidar::FeatureSet& features, const Eigen::Isometry3d& guess, ScanOutcome& out);
   void countMatch(ScanOutcome& out);
+  void onImu(const ImuSample& sample) {
+    const imu::SampleStatus status = fusion.addImu(sample);
+    if (std::optional<std::string> line = imu_notices.onSample(sample, status, last_imu)) notice(std::move(*line));
+    if (status == imu::SampleStatus::kAccepted || status == imu::SampleStatus::kAcceptedAfterGap) last_imu = sample.t;
+  }
   void notice(std::string line) {
     if (stats.notices.size() < OdometryStats::kMaxNotices) stats.notices.push_back(std::move(line));
   }
@@ -88,7 +96,7 @@ LidarOdometry::~LidarOdometry() = default;
 std::vector<ScanOutcome> LidarOdometry::process(const Measurement& m) {
   if (const auto* imu = std::get_if<ImuSample>(&m)) {
     if (!impl_->config.use_imu) return impl_->drain(false);
-    impl_->fusion.addImu(*imu);
+    impl_->onImu(*imu);
     std::vector<ScanOutcome> done = impl_->drain(false);
     // After the drain, so that a sweep this sample completed is already fused into the published state.
     const Time last = impl_->imu_rate.empty() ? std::numeric_limits<Time>::min() : impl_->imu_rate.back().t;
