@@ -30,7 +30,8 @@ class StopOnSignal {
   bool requested() const { return signal() != 0; }
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ = {};
+  struct sigaction old_term_ = {};
 };
 
 // "SIGINT", "SIGTERM" (else "signal N").

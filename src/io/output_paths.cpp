@@ -140,7 +140,8 @@ fs::path StagedFolder::check(const std::string& out, const StagingRules& rules) 
   if (fs::exists(fs::symlink_status(dir, ec))) {
     if (std::string why = whyNeverRemoved(dir); !why.empty()) fail(out, option, why);
     if (!rules.may_replace) fail(out, option, "already exists (" + rules.replace_hint + ")");
-    if (std::string why = rules.replaceable(dir); !why.empty()) fail(out, option, why + "; " + rules.refusal);
+    if (std::string why = rules.replaceable(dir); !why.empty())
+      fail(out, option, rules.refusal.empty() ? why : why + "; " + rules.refusal);
   }
   // A leftover OUT.partial goes when it carries the marker, or is a complete output whose marker was already
   // removed when the command was killed just before renaming it.
@@ -182,12 +183,15 @@ void StagedFolder::publish() {
   } else if (exchange(partial_, out_, option_)) {
     removeAll(partial_, option_, "the replaced folder");  // now holds the earlier OUT
   } else {
-    const fs::path parked = partial_ / kPreviousFolder;
-    renameOrFail(out_, parked, option_);
-    renameOrFail(partial_, out_, option_);
-    removeAll(out_ / kPreviousFolder, option_, "the replaced folder");
+    replaceByParking(partial_, out_, option_);
   }
   published_ = true;
+}
+
+void replaceByParking(const fs::path& partial, const fs::path& out, const std::string& option) {
+  renameOrFail(out, partial / kPreviousFolder, option);
+  renameOrFail(partial, out, option);
+  removeAll(out / kPreviousFolder, option, "the replaced folder");
 }
 
 }  // namespace drover::io

@@ -72,4 +72,10 @@ class StagedFolder {
   bool published_ = false;
 };
 
+// StagedFolder::publish's way where the file system cannot swap two folders: moves OUT to PARTIAL/kPreviousFolder,
+// PARTIAL to OUT, then removes OUT/kPreviousFolder (killed in between, the earlier OUT is still inside PARTIAL or
+// OUT). Public for its test.
+void replaceByParking(const std::filesystem::path& partial, const std::filesystem::path& out,
+                      const std::string& option);
+
 }  // namespace drover::io

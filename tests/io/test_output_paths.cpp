@@ -1,8 +1,6 @@
 // io/output_paths: output files and folders are checked before any work, and a staged folder replaces only what its
 // rules recognise, never `/`, the home folder, the working folder or its ancestors, and never loses the earlier
 // folder before the new one is complete.
-#include "io/output_paths.hpp"
-
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -12,6 +10,7 @@
 #include <vector>
 
 #include "io/error.hpp"
+#include "io/output_paths.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
@@ -153,6 +152,20 @@ TEST(StagedFolder, ReplacesAnEarlierFolderOnlyWhenPublishedKeepingItWholeUntilTh
   now >> text;
   EXPECT_EQ(text, "new");
   EXPECT_EQ(namesIn(dir.path()), std::set<std::string>{"run"});
+}
+
+TEST(ReplaceByParking, PutsTheNewFolderInPlaceAndRemovesTheEarlierOne) {
+  TempDir dir;
+  writeText(dir / "run" / "result.txt", "old");
+  writeText(dir / "run.partial" / "result.txt", "new");
+  writeText(dir / "run.partial" / "extra.txt", "new");
+  replaceByParking(dir / "run.partial", dir / "run", "--out");
+  EXPECT_EQ(namesIn(dir.path()), std::set<std::string>{"run"});
+  EXPECT_EQ(namesIn(dir / "run"), (std::set<std::string>{"result.txt", "extra.txt"}));
+  std::ifstream now(dir / "run" / "result.txt");
+  std::string text;
+  now >> text;
+  EXPECT_EQ(text, "new");
 }
 
 TEST(StagedFolder, ADestroyedUnpublishedFolderLeavesNothingAndTheEarlierFolderAsItWas) {
