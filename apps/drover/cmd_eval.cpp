@@ -12,6 +12,7 @@
 
 #include "apps/drover/commands.hpp"
 #include "apps/drover/eval_report.hpp"
+#include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace drover::cli {
@@ -52,14 +53,6 @@ std::optional<std::string> optionalPath(const std::string& s) {
   return s.empty() ? std::nullopt : std::optional<std::string>(s);
 }
 
-// Output files are checked before the work so a typo does not cost a long evaluation.
-void requireWritableParent(const std::string& path, const char* option) {
-  if (path.empty()) return;
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent))
-    throw std::invalid_argument(fmt::format("{} {}: folder {} does not exist", option, path, parent.string()));
-}
-
 eval::AssociationOptions associationOptions(const CommonOptions& o) {
   if (!std::isfinite(o.t_max_diff) || o.t_max_diff < 0)
     throw std::invalid_argument(fmt::format("--t-max-diff must be >= 0 s, got {}", o.t_max_diff));
@@ -69,8 +62,9 @@ eval::AssociationOptions associationOptions(const CommonOptions& o) {
 
 void loadBoth(const CommonOptions& o, Trajectory& ref, Trajectory& est) {
   const io::TrajectoryFormat format = io::parseTrajectoryFormat(o.format);
-  requireWritableParent(o.json, "--json");
-  requireWritableParent(o.plot, "--plot");
+  // Output files are checked before the work so a typo does not cost a long evaluation.
+  io::checkOutputFile(o.json, "--json");
+  io::checkOutputFile(o.plot, "--plot");
   ref = io::readTrajectory(o.ref, format, optionalPath(o.ref_times));
   est = io::readTrajectory(o.est, format, optionalPath(o.est_times));
   if (ref.empty()) throw std::invalid_argument(o.ref + ": no poses");

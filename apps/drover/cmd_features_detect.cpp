@@ -16,6 +16,7 @@
 
 #include "apps/drover/commands.hpp"
 #include "io/image_file_io.hpp"
+#include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
 #include "io/visual/visual_config_io.hpp"
 #include "visual/detector_factory.hpp"
@@ -93,6 +94,10 @@ void drawKeypoints(const std::string& path, const cv::Mat& grey, const visual::K
 }
 
 void runDetect(const DetectOptions& o) {
+  io::checkOutputFile(o.json, "--json");
+  if (!o.draw.empty())
+    for (std::size_t i = 0; i < o.images.size(); ++i)
+      io::checkOutputFile(drawPath(o.draw, i, o.images.size()), "--draw");
   const visual::DetectorConfig cfg = detectorConfig(o);
   const std::unique_ptr<visual::KeypointDetector> detector = visual::makeDetector(cfg);
   Json images = Json::array();

@@ -13,6 +13,7 @@
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "io/image_file_io.hpp"
+#include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
 #include "io/visual/visual_config_io.hpp"
 #include "visual/detector_factory.hpp"
@@ -74,6 +75,7 @@ void check(const TrackOptions& o) {
 
 void runTrack(const TrackOptions& o) {
   check(o);
+  io::checkOutputFolder(o.out, "--out");
   io::DatasetOptions options = o.config.empty() ? io::DatasetOptions{} : io::loadDatasetOptions(o.config);
   options.load_lidar = false;
   options.load_imu = false;

@@ -13,6 +13,7 @@
 #include "apps/drover/commands.hpp"
 #include "backend/pose_graph.hpp"
 #include "io/g2o_io.hpp"
+#include "io/output_paths.hpp"
 #include "io/odometry/g2o_pose_graph.hpp"
 #include "io/trajectory_io.hpp"
 
@@ -27,13 +28,6 @@ struct GraphOptimizeOptions {
   double loss_scale = 3.0;  // [sigmas]
   int threads = 1;
 };
-
-void requireWritableParent(const std::string& path, const char* what) {
-  if (path.empty()) return;
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  if (!parent.empty() && !std::filesystem::is_directory(parent))
-    throw std::invalid_argument(fmt::format("{} {}: folder {} does not exist", what, path, parent.string()));
-}
 
 nlohmann::ordered_json resultJson(const GraphOptimizeOptions& o, const backend::PoseGraphResult& r) {
   nlohmann::ordered_json j;
@@ -61,8 +55,8 @@ void runOptimize(const GraphOptimizeOptions& o) {
   config.threads = o.threads;
   const std::string why = config.validate();
   if (!why.empty()) throw std::invalid_argument("graph optimize: " + why);
-  requireWritableParent(o.out, "output");
-  requireWritableParent(o.json, "--json");
+  io::checkOutputFile(o.out, "output");
+  io::checkOutputFile(o.json, "--json");
 
   io::G2oGraph g2o = io::readG2o(o.in);
   backend::PoseGraph graph = io::toPoseGraph(g2o, config, o.in);

@@ -12,6 +12,7 @@
 #include "apps/drover/commands.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
+#include "io/output_paths.hpp"
 #include "io/text_parsing.hpp"
 #include "io/trajectory_io.hpp"
 
@@ -221,18 +222,18 @@ std::string summaryText(const Json& j, const Summary& s, const io::Reader& reade
 }
 
 void runInfo(const InfoOptions& o) {
+  io::checkOutputFile(o.json, "--json");  // before streaming the dataset, which can take minutes
+  io::checkOutputFile(o.export_gt, "--export-gt");
   io::DatasetOptions options = o.config.empty() ? io::DatasetOptions{} : io::loadDatasetOptions(o.config);
   if (o.max_frames > 0) options.kitti_max_frames = o.max_frames;
   const std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, options);
+  if (!o.export_gt.empty() && reader->groundTruth().poses.empty())
+    throw std::runtime_error(o.dataset + ": the dataset has no ground truth to export to " + o.export_gt);
   const Summary summary = streamDataset(*reader);
   const Json j = summaryJson(o, *reader, summary);
   fmt::print("{}", summaryText(j, summary, *reader));
   if (!o.json.empty()) io::writeFileAtomically(o.json, j.dump(2) + "\n");
-  if (!o.export_gt.empty()) {
-    if (reader->groundTruth().poses.empty())
-      throw std::runtime_error(o.dataset + ": the dataset has no ground truth to export to " + o.export_gt);
-    io::writeTum(o.export_gt, reader->groundTruth().poses);
-  }
+  if (!o.export_gt.empty()) io::writeTum(o.export_gt, reader->groundTruth().poses);
 }
 
 }  // namespace

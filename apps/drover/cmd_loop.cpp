@@ -15,6 +15,7 @@
 #include "apps/drover/eval_report.hpp"
 #include "io/kitti_common.hpp"
 #include "io/odometry/odometry_config_io.hpp"
+#include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
 #include "pipeline/scan_pair.hpp"
 
@@ -54,6 +55,7 @@ Json verificationJson(const loop::LoopVerification& v) {
 
 void runPair(const PairOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
+  io::checkOutputFile(o.json, "--json");
   for (const std::string& p : {o.a, o.b})
     if (!std::filesystem::exists(p)) throw std::invalid_argument("scan " + p + " not found");
   const pipeline::OdometryConfig config = pairConfig(o);

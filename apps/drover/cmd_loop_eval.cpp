@@ -11,6 +11,7 @@
 #include "apps/drover/commands.hpp"
 #include "apps/drover/eval_report.hpp"
 #include "apps/drover/loop_eval.hpp"
+#include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
 
 namespace drover::cli {
@@ -64,6 +65,7 @@ Json resultJson(const LoopEvalOptions& o, const LoopEvalData& d, const loop::PrC
 
 void runLoopEval(const LoopEvalOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
+  io::checkOutputFile(o.json, "--json");  // before the evaluation, which reads a whole dataset
   const pipeline::OdometryConfig config = loopEvalConfig(o);
   const LoopEvalData d = o.pairs.empty() ? evaluateCourse(o, config) : evaluatePairs(o, config);
   const double threshold = config.loop.database.descriptor.threshold;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "apps/drover/commands.hpp"
+#include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
@@ -69,6 +70,7 @@ void checkOptions(const RunOptions& o) {
   if (!std::isfinite(o.duration) || o.duration < 0)
     throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
   if (!fs::exists(o.dataset)) throw std::invalid_argument("dataset " + o.dataset + " not found");
+  io::StagedFolder::check(o.out, runFolderRules());  // before any work: a foreign or unusable --out costs nothing
 }
 
 void keep(std::vector<pipeline::ScanOutcome>&& outcomes, RunRecord& record) {
@@ -141,13 +143,19 @@ void runOdometry(const RunOptions& o) {
       spdlog::warn("{}", drops.notices[record.reader_notices_shown]);
     record.measurements_dropped = drops.measurements;
   };
-  while (std::optional<Measurement> m = reader->next()) {
+  std::size_t scans_read = 0;  // lidar scans the reader gave, before --start included
+  StopOnSignal stop;           // SIGINT/SIGTERM: stop reading and write what was processed
+  while (std::optional<Measurement> m = stop.requested() ? std::nullopt : reader->next()) {
     showReaderDrops();
     const Time t = measurementTime(*m);
     if (!t_first) t_first = t;
     const double since = toSeconds(t - *t_first);
+    scans_read += std::holds_alternative<LidarScan>(*m) ? 1 : 0;
     if (since < o.start) continue;
-    if (o.duration > 0 && since > o.start + o.duration) break;
+    if (o.duration > 0 && since > o.start + o.duration) {
+      record.end = "--duration reached";
+      break;
+    }
     if (const auto* scan = std::get_if<LidarScan>(&*m))
       record.scan_times.push_back(scan->t + reader->calibration().lidar_time_offset);
     keep(odometry.process(*m), record);
@@ -155,14 +163,23 @@ void runOdometry(const RunOptions& o) {
     progress.update(record.scans.size(), since - o.start);
   }
   showReaderDrops();
+  if (o.max_frames > 0 && o.format == "kitti" && scans_read >= o.max_frames) record.end = "--max-frames reached";
+  const int interrupted_by = stop.signal();  // a signal after the reading is done changes nothing
+  if (interrupted_by) record.end = "interrupted by " + signalName(interrupted_by);
   keep(odometry.finish(), record);
   showNotices(odometry, o, record);
   checkSomethingWasDone(odometry.stats(), o);
   record.wall_s = progress.wallSeconds();
   record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
-  fs::create_directories(o.out);  // only now: a run that fails on its data leaves no folder behind
-  RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt};
+  // Only now, and as OUT.partial: a run that fails on its data leaves no folder behind, one killed while writing
+  // leaves an earlier run in OUT whole.
+  io::StagedFolder folder(o.out, runFolderRules());
+  RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string()};
   writeRunFolder(context, odometry, record);
+  folder.publish();
+  if (!interrupted_by) return;
+  spdlog::warn("{}: wrote the {} sweeps processed before it to {}", record.end, record.scans.size(), o.out);
+  throw ExitCode{128 + interrupted_by};  // as a shell reports a command a signal ended
 }
 
 }  // namespace
@@ -176,7 +193,8 @@ void registerRun(CLI::App& app) {
       ->required()
       ->check(CLI::IsMember({"kitti", "kitti-raw", "euroc", "bag", "sim"}));
   cmd->add_option("--config", o->config, "Platform config (config/kitti.yaml, farm_sim.yaml, ...)");
-  cmd->add_option("--out", o->out, "Run folder (created; files in it are replaced)")->required();
+  cmd->add_option("--out", o->out, "Run folder (written as OUT.partial, renamed when complete; replaces only an "
+                                  "earlier run folder)")->required();
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");
   cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera (the LIS does not use it yet either way)");

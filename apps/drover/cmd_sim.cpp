@@ -90,8 +90,11 @@ void checkOptions(const SimOptions& o) {
     throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
   if (!std::isfinite(o.camera_rate) || o.camera_rate < 0)
     throw std::invalid_argument(fmt::format("--camera-rate must be > 0 Hz, got {}", o.camera_rate));
-  if (fs::exists(o.out) && !o.force)
-    throw std::invalid_argument("output folder " + o.out + " already exists (use --force to replace it)");
+  // Before any simulation: --force replaces only an earlier dataset (or an empty folder), never ".", "..", the
+  // home folder or a file.
+  io::SimWriterOptions wo;
+  wo.overwrite = o.force;
+  io::SimDatasetWriter::checkOutput(o.out, wo);
 }
 
 // Prints "t / T s (p%), x sim-s/s, ETA" about every 2 s of wall time.
@@ -168,7 +171,7 @@ void registerSim(CLI::App& app) {
   cmd->add_option("--kitti-poses", o->kitti_poses, "kitti05-replay: KITTI poses file (default ../shared/data)");
   cmd->add_option("--kitti-times", o->kitti_times, "kitti05-replay: KITTI times.txt (default ../shared/data)");
   cmd->add_flag("--no-camera", o->no_camera, "Do not render camera images");
-  cmd->add_flag("--force", o->force, "Replace an existing output folder");
+  cmd->add_flag("--force", o->force, "Replace an existing output folder that holds an earlier simulated dataset");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runSim(*o); });
 }

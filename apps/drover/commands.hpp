@@ -5,6 +5,12 @@
 
 namespace drover::cli {
 
+// Thrown by a command that did its work but must exit with another code than 0 (an interrupted `drover run`:
+// 128 + the signal, as a shell reports it); main() prints nothing more.
+struct ExitCode {
+  int code;
+};
+
 void registerEval(CLI::App& app);
 void registerInfo(CLI::App& app);
 void registerSim(CLI::App& app);

@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     return 2;
+  } catch (const drover::cli::ExitCode& e) {
+    return e.code;
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
     return 2;

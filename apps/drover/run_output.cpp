@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 
 constexpr float kMapLeaf = 0.2f;  // [m] voxel leaf of the exported map
 
-std::string inRun(const RunContext& c, const char* name) { return (fs::path(c.out) / name).string(); }
+std::string inRun(const RunContext& c, const char* name) { return (fs::path(c.dir) / name).string(); }
 
 // T_world_lidar -> T_world_body for the ground truth's body frame ("imu": T_world_imu = T_world_lidar T_lidar_imu).
 Trajectory inBodyFrame(const Trajectory& lidar, const RunContext& c) {
@@ -229,6 +229,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["config"] = c.config;
   report["mode"] = s.imu_initialized ? "lidar+imu" : "lidar";  // what was fused (the IMU may have been given up)
   report["imu_requested"] = odometry.config().use_imu;
+  report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};
   report["body_frame"] = c.ground_truth.body_frame.empty() ? "lidar" : c.ground_truth.body_frame;
   report["wall_s"] = r.wall_s;
   report["data_s"] = r.data_s;

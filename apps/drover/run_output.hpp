@@ -8,7 +8,7 @@
 //   trajectory_imu_rate.tum  with the IMU: the IMU-rate odometry (the fused state propagated to each IMU sample as
 //                         it arrives), same frame as trajectory.tum
 //   map.pcd, map.ply      the keyframes' clouds in the world frame (binary)
-//   report.json           counts, per-stage timings, degenerate sweeps, resets, and the APE when there is ground truth
+//   report.json           how the run ended, counts, per-stage timings, degenerate sweeps, resets, and the APE when there is ground truth
 //   ape.json, ape.png     APE (translation, SE(3)-aligned) against the ground truth, when there is one
 #include <string>
 #include <vector>
@@ -22,6 +22,7 @@ struct RunContext {
   std::string dataset, format, config, out;
   const Calibration& calibration;
   const io::GroundTruth& ground_truth;
+  std::string dir;  // where the files are written: OUT.partial, renamed to `out` when complete
 };
 
 struct RunRecord {
@@ -33,6 +34,9 @@ struct RunRecord {
   bool fusion_announced = false;  // the "fusing: ..." line was printed
   std::size_t reader_notices_shown = 0;  // io::ReaderDrops::notices already printed
   std::size_t measurements_dropped = 0;  // by the reader: a repeated or backwards stamp, or an unusable reading
+  // Why the run stopped (report.json "end"): "end of data", "--duration reached", "--max-frames reached" or
+  // "interrupted by SIGINT" / "SIGTERM".
+  std::string end = "end of data";
 };
 
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be

@@ -53,6 +53,7 @@
 #include <vector>
 
 #include "io/dataset.hpp"
+#include "io/output_paths.hpp"
 #include "io/reader.hpp"
 #include "types/calibration.hpp"
 #include "types/measurement.hpp"
@@ -103,8 +104,14 @@ struct SimDatasetDescription {
   SimScenarioInfo scenario;
 };
 
+// "" when DIR (an existing folder) is empty or holds a complete simulated dataset and nothing else, so replacing it
+// loses nothing but that dataset; else why not ("holds notes.txt, which drover sim does not write ...").
+std::string simDatasetProblem(const std::filesystem::path& dir);
+
 struct SimWriterOptions {
-  bool overwrite = false;       // replace an existing DIR (else the constructor throws std::invalid_argument)
+  // Replace an existing DIR, which must then be a dataset (simDatasetProblem) and not a folder that is never
+  // replaced (io/output_paths.hpp); else the constructor throws IoError(DIR, "--out", why).
+  bool overwrite = false;
   int png_compression = 1;      // cv::IMWRITE_PNG_COMPRESSION, 0..9 (1: fast; images are large and many)
   std::size_t max_queued_images = 16;  // images waiting for the background PNG encoder
 };
@@ -116,8 +123,9 @@ struct SimWriterCounts {
 
 // Writes a dataset measurement by measurement (each stream must come in strictly increasing time; other input
 // throws std::invalid_argument). PNGs are encoded on a background thread while the caller goes on.
-// finish() writes the ground truth and the index files and renames DIR.partial to DIR; a writer destroyed
-// without finish() removes DIR.partial.
+// The constructor removes a leftover DIR.partial only when an interrupted writer left it (its marker file, or a
+// complete dataset). finish() writes the ground truth and the index files and swaps DIR.partial in as DIR (an
+// earlier DIR stays whole until then); a writer destroyed without finish() removes DIR.partial.
 class SimDatasetWriter {
  public:
   SimDatasetWriter(const std::string& dir, const SimDatasetDescription& description,
@@ -127,6 +135,8 @@ class SimDatasetWriter {
   SimDatasetWriter& operator=(const SimDatasetWriter&) = delete;
 
   void add(Measurement&& m);
+  // Why DIR may not be written with these options (checked by the constructor too); throws IoError.
+  static void checkOutput(const std::string& dir, const SimWriterOptions& options);
   // ground_truth: T_world_imu, strictly increasing in time.
   void finish(const Trajectory& ground_truth);
   const SimWriterCounts& counts() const { return counts_; }
@@ -144,6 +154,7 @@ class SimDatasetWriter {
   void stopEncoder();
   void rethrowEncoderError();
 
+  std::unique_ptr<StagedFolder> staged_;
   std::filesystem::path dir_, partial_;
   SimDatasetDescription description_;
   SimWriterOptions options_;

@@ -109,6 +109,15 @@ void writeBinary(const fs::path& path, const std::string& bytes) {
   if (!out.flush()) fail(path.string(), "", "write failed (disk full?)");
 }
 
+StagingRules simStagingRules(const SimWriterOptions& options) {
+  StagingRules rules;
+  rules.may_replace = options.overwrite;
+  rules.replace_hint = "use --force to replace it";
+  rules.replaceable = simDatasetProblem;
+  rules.refusal = "--force replaces only an earlier simulated dataset";
+  return rules;
+}
+
 }  // namespace
 
 std::string simFileName(std::size_t index, const char* extension) {
@@ -117,24 +126,23 @@ std::string simFileName(std::size_t index, const char* extension) {
   return buf;
 }
 
+void SimDatasetWriter::checkOutput(const std::string& dir, const SimWriterOptions& options) {
+  StagedFolder::check(dir, simStagingRules(options));
+}
+
 SimDatasetWriter::SimDatasetWriter(const std::string& dir, const SimDatasetDescription& description,
                                    const SimWriterOptions& options)
-    : dir_(fs::path(dir).lexically_normal()), description_(description), options_(options) {
-  if (dir_.filename().empty()) dir_ = dir_.parent_path();  // "out/farm/" -> "out/farm"
-  if (dir_.empty()) throw std::invalid_argument("sim writer: empty output folder name");
+    : description_(description), options_(options) {
   if (options.png_compression < 0 || options.png_compression > 9)
     throw std::invalid_argument("sim writer: png_compression must be 0..9, got " +
                                 std::to_string(options.png_compression));
   if (description.sensors.camera_channels != 1 && description.sensors.camera_channels != 3)
     throw std::invalid_argument("sim writer: camera channels must be 1 or 3, got " +
                                 std::to_string(description.sensors.camera_channels));
-  if (fs::exists(dir_) && !options.overwrite)
-    throw std::invalid_argument("output folder " + dir_.string() + " already exists (use --force to replace it)");
-  partial_ = dir_;
-  partial_ += ".partial";
+  staged_ = std::make_unique<StagedFolder>(dir, simStagingRules(options));
+  dir_ = staged_->out();
+  partial_ = staged_->dir();
   std::error_code ec;
-  fs::remove_all(partial_, ec);  // left by an interrupted run
-  if (ec) fail(partial_.string(), "", "cannot remove the stale partial folder: " + ec.message());
   fs::create_directories(partial_ / "lidar", ec);
   if (!ec) fs::create_directories(partial_ / "camera", ec);
   if (ec) fail(partial_.string(), "", "cannot create folder: " + ec.message());
@@ -145,10 +153,7 @@ SimDatasetWriter::SimDatasetWriter(const std::string& dir, const SimDatasetDescr
 
 SimDatasetWriter::~SimDatasetWriter() {
   stopEncoder();
-  if (!finished_) {
-    std::error_code ec;
-    fs::remove_all(partial_, ec);
-  }
+  staged_.reset();  // unless finished, removes DIR.partial (after the encoder stopped writing into it)
 }
 
 void SimDatasetWriter::add(Measurement&& m) {
@@ -282,11 +287,7 @@ void SimDatasetWriter::finish(const Trajectory& ground_truth) {
   writeFileAtomically((partial_ / "scenario.json").string(), scenarioJson(description_));
   // calibration.yaml last: a folder holding it was written completely.
   writeFileAtomically((partial_ / "calibration.yaml").string(), calibrationYaml(description_));
-  std::error_code ec;
-  if (fs::exists(dir_)) fs::remove_all(dir_, ec);  // only reachable with options.overwrite
-  if (ec) fail(dir_.string(), "", "cannot remove the existing dataset: " + ec.message());
-  fs::rename(partial_, dir_, ec);
-  if (ec) fail(dir_.string(), "", "cannot rename " + partial_.string() + " to it: " + ec.message());
+  staged_->publish();
   finished_ = true;
 }
 

@@ -206,13 +206,32 @@ TEST(SimDataset, LoadOptionsDropStreams) {
 TEST(SimDatasetWriter, RefusesAnExistingFolderUnlessOverwriting) {
   TempDir tmp;
   const fs::path dir = writeDataset(tmp);
-  EXPECT_THROW(SimDatasetWriter(dir.string(), description()), std::invalid_argument);
+  expectIoError([&] { SimDatasetWriter(dir.string(), description()); }, {"(--out)", "already exists", "--force"});
   SimWriterOptions o;
   o.overwrite = true;
   SimDatasetWriter w(dir.string(), description(), o);
   w.add(imuAt(7));
   w.finish(groundTruth());
   EXPECT_EQ(readAll(dir).size(), 1u);  // replaced
+}
+
+TEST(SimDatasetWriter, OverwritesOnlyADatasetAndNeverTheWorkingFolder) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  test::writeText(dir / "notes.txt", "the user's");
+  SimWriterOptions o;
+  o.overwrite = true;
+  expectIoError([&] { SimDatasetWriter(dir.string(), description(), o); },
+                {"(--out)", "holds notes.txt, which drover sim does not write"});
+  EXPECT_TRUE(fs::exists(dir / "notes.txt"));
+  EXPECT_TRUE(fs::exists(dir / "calibration.yaml"));
+  fs::remove(dir / "notes.txt");
+  EXPECT_EQ(simDatasetProblem(dir), "");
+  const fs::path cwd = fs::current_path();
+  fs::current_path(dir);
+  expectIoError([&] { SimDatasetWriter(".", description(), o); }, {"(--out)", "working folder"});
+  fs::current_path(cwd);
+  EXPECT_TRUE(fs::exists(dir / "calibration.yaml"));
 }
 
 TEST(SimDatasetWriter, InterruptedWriteLeavesNoDatasetBehind) {
