@@ -249,7 +249,10 @@ TEST(Config, TimeOffsetsAreCheckedSecondsNamingTheRange) {
   const std::string msg = errorOf("calibration:\n  camera_time_offset: 1e10\n");
   EXPECT_TRUE(contains(msg, "line 2, key 'calibration.camera_time_offset'")) << msg;
   EXPECT_TRUE(contains(msg, "expected [-3600, 3600] s")) << msg;
-  EXPECT_TRUE(contains(errorOf("calibration:\n  lidar_time_offset: .nan\n"), "finite")) << msg;
+  for (const char* nan : {".nan", "nan", "-inf"}) {
+    const std::string e = errorOf(std::string("calibration:\n  lidar_time_offset: ") + nan + "\n");
+    EXPECT_TRUE(contains(e, "key 'calibration.lidar_time_offset'") && contains(e, nan)) << e;
+  }
 }
 
 TEST(Config, AHugeValueIsEchoedShortened) {
