@@ -10,10 +10,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "apps/drover/eval_report.hpp"
 #include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
+#include "io/user_values.hpp"
 
 namespace drover::cli {
 namespace {
@@ -53,11 +55,10 @@ std::optional<std::string> optionalPath(const std::string& s) {
   return s.empty() ? std::nullopt : std::optional<std::string>(s);
 }
 
+// Both were checked when the command line was read (addSeconds); converted here through the same checks.
 eval::AssociationOptions associationOptions(const CommonOptions& o) {
-  if (!std::isfinite(o.t_max_diff) || o.t_max_diff < 0)
-    throw std::invalid_argument(fmt::format("--t-max-diff must be >= 0 s, got {}", o.t_max_diff));
-  if (!std::isfinite(o.t_offset)) throw std::invalid_argument("--t-offset must be finite");
-  return {fromSeconds(o.t_max_diff), fromSeconds(o.t_offset)};
+  return {io::checkedSeconds(o.t_max_diff, atLeast(0, "s"), io::ValueSource::option("--t-max-diff")),
+          io::checkedSeconds(o.t_offset, io::Range{}, io::ValueSource::option("--t-offset"))};
 }
 
 void loadBoth(const CommonOptions& o, Trajectory& ref, Trajectory& est) {
@@ -195,9 +196,10 @@ void addMetricOptions(CLI::App* cmd, CommonOptions& o) {
   cmd->add_option("--align", o.align, "Umeyama alignment of the estimate onto the reference")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "se3", "sim3"}));
-  cmd->add_option("--t-max-diff", o.t_max_diff, "Largest time difference of an associated pair [s]")
-      ->capture_default_str();
-  cmd->add_option("--t-offset", o.t_offset, "Time offset added to the estimate's stamps [s]")->capture_default_str();
+  addSeconds(cmd, "--t-max-diff", o.t_max_diff, atLeast(0, "s"), "Largest time difference of an associated pair [s]")
+      ->default_str("0.01");
+  addSeconds(cmd, "--t-offset", o.t_offset, io::Range{}, "Time offset added to the estimate's stamps [s]")
+      ->default_str("0");
   cmd->add_option("--pose-relation", o.relation, "Error measure")
       ->capture_default_str()
       ->check(CLI::IsMember({"trans", "rot", "full", "angle_deg"}));
@@ -220,7 +222,8 @@ void registerEval(CLI::App& app) {
   auto* rpe_cmd = eval->add_subcommand("rpe", "Relative pose error with consecutive pairs, as evo_rpe");
   addInputs(rpe_cmd, rpe->common, "tum");
   addMetricOptions(rpe_cmd, rpe->common);
-  rpe_cmd->add_option("--delta", rpe->delta, "Distance between the poses of a pair")->capture_default_str();
+  addNumber(rpe_cmd, "--delta", rpe->delta, positive(""), "Distance between the poses of a pair (frames: an integer)")
+      ->default_str("1");
   rpe_cmd->add_option("--delta-unit", rpe->delta_unit, "Unit of --delta")->capture_default_str()
       ->check(CLI::IsMember({"frames", "meters", "f", "m"}));
   rpe_cmd->add_flag("--pairs-from-reference", rpe->pairs_from_reference,

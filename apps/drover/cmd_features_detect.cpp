@@ -9,15 +9,17 @@
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
+#include "io/error.hpp"
 #include "io/image_file_io.hpp"
 #include "io/output_paths.hpp"
 #include "io/trajectory_io.hpp"
+#include "io/user_values.hpp"
 #include "io/visual/visual_config_io.hpp"
 #include "visual/detector_factory.hpp"
 #include "visual/image_darkening.hpp"
@@ -42,13 +44,12 @@ visual::DetectorConfig detectorConfig(const DetectOptions& o) {
   if (!o.detector.empty()) c.type = visual::parseDetectorType(o.detector);
   if (!o.weights.empty()) c.superpoint.weights = o.weights;
   if (!o.input_size.empty()) {
-    int w = 0, h = 0;
-    char x = 0;
-    std::istringstream in(o.input_size);
-    if (!(in >> w >> x >> h) || x != 'x' || !in.eof())
-      throw std::invalid_argument("--input-size must be WxH (e.g. 640x480), got '" + o.input_size + "'");
-    c.superpoint.input_width = w;
-    c.superpoint.input_height = h;
+    const io::ValueSource source = io::ValueSource::option("--input-size");
+    const std::size_t x = o.input_size.find('x');
+    if (x == std::string::npos) io::failValue(source, "expected WxH (e.g. 640x480), got " + io::echo(o.input_size));
+    // [px] each side; validate() below asks for multiples of 8.
+    c.superpoint.input_width = static_cast<int>(io::parseInteger(o.input_size.substr(0, x), 8, 16384, source));
+    c.superpoint.input_height = static_cast<int>(io::parseInteger(o.input_size.substr(x + 1), 8, 16384, source));
   }
   if (std::string err = c.validate(); !err.empty()) throw std::invalid_argument(err);
   return c;
@@ -153,17 +154,17 @@ void registerFeaturesDetect(CLI::App& features) {
   cmd->add_option("--weights", o->weights,
                   "SuperPoint ONNX weights (default ../shared/models/superpoint_v1.onnx: MagicLeap, non-commercial)");
   cmd->add_option("--input-size", o->input_size, "SuperPoint network input WxH, multiples of 8 (default: the image)");
-  cmd->add_option("--max", o->max, "At most N keypoints per image (default: the detector's cap)")
-      ->check(CLI::NonNegativeNumber);
+  addInteger(cmd, "--max", o->max, 1, 1'000'000, "At most N keypoints per image, N >= 1 (default: the detector's cap)");
   cmd->add_option("--json", o->json,
                   "Also write {detector, settings, images: [{path, count, coverage, ms, mean_intensity}]}");
   cmd->add_flag("--json-points", o->json_points, "Also write each image's keypoints [[x, y], ...] to the JSON");
   cmd->add_option("--draw", o->draw, "Write the image with its keypoints (several images: OUT_<index>.png)");
-  cmd->add_option("--darken", o->darken,
-                  "Detect on a darkened copy: exposure x SCALE, shot noise (1 grey level/e-) and read noise "
-                  "(sigma 2 grey levels)")
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--seed", o->seed, "Noise seed for --darken (image i uses seed + i)");
+  io::Range exposure{0, 1};
+  exposure.min_open = true;
+  addNumber(cmd, "--darken", o->darken, exposure,
+            "Detect on a darkened copy: exposure x SCALE in (0, 1], shot noise (1 grey level/e-) and read noise "
+            "(sigma 2 grey levels)");
+  addSeed(cmd, "--seed", o->seed, "Noise seed for --darken in [0, 2^64 - 1] (image i uses seed + i)");
   cmd->callback([o] { runDetect(*o); });
 }
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
@@ -63,18 +64,7 @@ Json summaryJson(const visual::TrackingSummary& s) {
               {"fraction_tracked_ge_50", s.fraction_tracked_ge_50}};
 }
 
-void check(const TrackOptions& o) {
-  if (!std::isfinite(o.start) || o.start < 0)
-    throw std::invalid_argument(fmt::format("--start must be >= 0 s, got {}", o.start));
-  if (!std::isfinite(o.duration) || o.duration < 0)
-    throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
-  if (o.overlay_every < 0)
-    throw std::invalid_argument(fmt::format("--overlay-every must be >= 0, got {}", o.overlay_every));
-  if (o.max_frames < 0) throw std::invalid_argument(fmt::format("--max-frames must be >= 0, got {}", o.max_frames));
-}
-
 void runTrack(const TrackOptions& o) {
-  check(o);
   io::checkOutputFolder(o.out, "--out");
   io::DatasetOptions options = o.config.empty() ? io::DatasetOptions{} : io::loadDatasetOptions(o.config);
   options.load_lidar = false;
@@ -154,10 +144,11 @@ void registerFeaturesTrack(CLI::App& features) {
       ->check(CLI::IsMember({"superpoint", "shi-tomasi", "orb"}));
   cmd->add_option("--weights", o->weights, "SuperPoint ONNX file (default ../shared/models/superpoint_v1.onnx)");
   cmd->add_option("--out", o->out, "Output folder: tracks.json and overlay_NNNNNN.png")->required();
-  cmd->add_option("--overlay-every", o->overlay_every, "Write an overlay PNG every N frames (0 = none)");
-  cmd->add_option("--max-frames", o->max_frames, "Track at most N frames (0 = all)");
-  cmd->add_option("--start", o->start, "Skip the first S seconds of camera frames");
-  cmd->add_option("--duration", o->duration, "Track S seconds after --start (0 = to the end)");
+  addInteger(cmd, "--overlay-every", o->overlay_every, 0, 1'000'000'000,
+             "Write an overlay PNG every N frames (0 = none)");
+  addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000, "Track at most N >= 1 frames (default: all)");
+  addSeconds(cmd, "--start", o->start, atLeast(0, "s"), "Skip the first S seconds of camera frames");
+  addSeconds(cmd, "--duration", o->duration, atLeast(0, "s"), "Track S seconds after --start (0 = to the end)");
   cmd->add_flag("--async", o->async,
                 "Run the detector in a worker thread (results then depend on timing; overrides the config)");
   cmd->add_flag("-q,--quiet", o->quiet, "Print only errors");

@@ -10,6 +10,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "backend/pose_graph.hpp"
 #include "io/g2o_io.hpp"
@@ -84,13 +85,14 @@ void registerGraph(CLI::App& app) {
   auto o = std::make_shared<GraphOptimizeOptions>();
   cmd->add_option("input", o->in, "g2o file to read")->required();
   cmd->add_option("output", o->out, "g2o file to write, with the optimised vertices (atomically)")->required();
-  cmd->add_option("--max-iterations", o->max_iterations, "Levenberg-Marquardt iterations (>= 1)")
-      ->capture_default_str();
+  addInteger(cmd, "--max-iterations", o->max_iterations, 1, 1'000'000, "Levenberg-Marquardt iterations (>= 1)")
+      ->default_str("100");
   cmd->add_option("--loss", o->loss, "Robust loss on loop edges (ids not consecutive)")
       ->check(CLI::IsMember({"none", "huber", "cauchy"}))
       ->capture_default_str();
-  cmd->add_option("--loss-scale", o->loss_scale, "Loss scale in whitened units (sigmas)")->capture_default_str();
-  cmd->add_option("--threads", o->threads, "Ceres threads")->capture_default_str();
+  addNumber(cmd, "--loss-scale", o->loss_scale, positive("sigmas"), "Loss scale in whitened units (sigmas, > 0)")
+      ->default_str("3");
+  addInteger(cmd, "--threads", o->threads, 1, 1024, "Ceres threads (1..1024)")->default_str("1");
   cmd->add_option("--json", o->json, "Also write the figures as JSON to this file");
   cmd->callback([o] { runOptimize(*o); });
 }

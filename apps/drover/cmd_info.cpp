@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
@@ -250,7 +251,8 @@ void registerInfo(CLI::App& app) {
   cmd->add_option("--config", o->config, "Platform config (config/*.yaml): topics, sensors to load, calibration");
   cmd->add_option("--json", o->json, "Also write the summary as JSON to this file");
   cmd->add_option("--export-gt", o->export_gt, "Write the ground truth (T_world_body) as a TUM file");
-  cmd->add_option("--max-frames", o->max_frames, "KITTI odometry: read only the first N frames (0 = all)");
+  addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000,
+             "KITTI odometry: read only the first N >= 1 frames (default: all)");
   cmd->callback([o] { runInfo(*o); });
 }
 

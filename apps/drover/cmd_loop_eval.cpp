@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "apps/drover/eval_report.hpp"
 #include "apps/drover/loop_eval.hpp"
@@ -102,18 +103,19 @@ void registerLoopEval(CLI::App& loop) {
       ->check(CLI::IsMember({"sim", "kitti", "kitti-raw", "bag"}))
       ->capture_default_str();
   cmd->add_option("--config", o->config, "Platform config (layout, features, loop sections); default: KITTI HDL-64E");
-  cmd->add_option("--keyframe-distance", o->keyframe_distance, "[m] ground-truth travel between keyframes")
-      ->capture_default_str();
-  cmd->add_option("--true-distance", o->true_distance,
-                  "[m] a query has a true revisit when an eligible keyframe is this close; the best candidate is the "
-                  "right place within twice this")
-      ->capture_default_str();
-  cmd->add_option("--threshold", o->threshold, "Scan Context distance threshold (default: the config's)")
-      ->check(CLI::Range(0.0, 2.0));
+  addNumber(cmd, "--keyframe-distance", o->keyframe_distance, positive("m"),
+            "[m] ground-truth travel between keyframes (> 0)")
+      ->default_str("1");
+  addNumber(cmd, "--true-distance", o->true_distance, positive("m"),
+            "[m] a query has a true revisit when an eligible keyframe is this close; the best candidate is the "
+            "right place within twice this (> 0)")
+      ->default_str("3");
+  addNumber(cmd, "--threshold", o->threshold, between(0, 2, ""),
+            "Scan Context distance threshold in [0, 2] (default: the config's)");
   cmd->add_flag("--no-augment", o->no_augment, "No lateral augmentation of the queries");
   cmd->add_option("--pairs", o->pairs, "Pair list 'i j label' per line (mode B)");
   cmd->add_option("--json", o->json, "Write precision, recall, f1, counts, curve and timings as JSON");
-  cmd->add_option("--max-frames", o->max_frames, "Read at most this many scans (0 = all)");
+  addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000, "Read at most N >= 1 scans (default: all)");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runLoopEval(*o); });
 }

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
@@ -198,9 +199,10 @@ void registerRun(CLI::App& app) {
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");
   cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera (the LIS does not use it yet either way)");
-  cmd->add_option("--start", o->start, "Skip the first S seconds of the dataset");
-  cmd->add_option("--duration", o->duration, "Process S seconds after --start (0 = to the end)");
-  cmd->add_option("--max-frames", o->max_frames, "KITTI odometry: read only the first N frames of times.txt");
+  addSeconds(cmd, "--start", o->start, atLeast(0, "s"), "Skip the first S seconds of the dataset");
+  addSeconds(cmd, "--duration", o->duration, atLeast(0, "s"), "Process S seconds after --start (0 = to the end)");
+  addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000,
+             "KITTI odometry: read only the first N >= 1 frames of times.txt");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runOdometry(*o); });
 }

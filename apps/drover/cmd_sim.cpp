@@ -13,9 +13,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "io/sim_dataset.hpp"
+#include "io/error.hpp"
 #include "io/trajectory_io.hpp"
+#include "io/user_values.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
 
@@ -28,7 +31,7 @@ struct SimOptions {
   std::string scenario, out, format = "folder", config, lidar, kitti_poses, kitti_times;
   std::uint64_t seed = 1;
   double duration = 0;     // [s], 0 = the scenario's natural length
-  double camera_rate = 0;  // [Hz], 0 = config / default
+  std::optional<double> camera_rate;  // [Hz]; unset: the config's, else 15
   bool no_camera = false, force = false, quiet = false;
 };
 
@@ -70,7 +73,7 @@ sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
   if (s.lidar_rate_hz) c.lidar.rate_hz = *s.lidar_rate_hz;
   if (s.lidar_columns) c.lidar.columns = *s.lidar_columns;
   if (s.camera_rate_hz) c.camera.rate_hz = *s.camera_rate_hz;
-  if (o.camera_rate > 0) c.camera.rate_hz = o.camera_rate;
+  if (o.camera_rate) c.camera.rate_hz = *o.camera_rate;
   if (s.camera_color) c.camera.color = *s.camera_color;
   if (s.imu_rate_hz) c.imu.rate_hz = *s.imu_rate_hz;
   if (s.ground_truth_rate_hz) c.ground_truth_rate_hz = *s.ground_truth_rate_hz;
@@ -85,11 +88,8 @@ sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
 void checkOptions(const SimOptions& o) {
   const std::vector<std::string> names = sim::scenarioNames();
   if (std::find(names.begin(), names.end(), o.scenario) == names.end())
-    throw std::invalid_argument("unknown scenario '" + o.scenario + "' (expected one of: " + joined(names) + ")");
-  if (!std::isfinite(o.duration) || o.duration < 0)
-    throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
-  if (!std::isfinite(o.camera_rate) || o.camera_rate < 0)
-    throw std::invalid_argument(fmt::format("--camera-rate must be > 0 Hz, got {}", o.camera_rate));
+    throw std::invalid_argument("--scenario: unknown scenario " + io::echo(o.scenario) +
+                                " (expected one of: " + joined(names) + ")");
   // Before any simulation: --force replaces only an earlier dataset (or an empty folder), never ".", "..", the
   // home folder or a file.
   io::SimWriterOptions wo;
@@ -161,11 +161,19 @@ void registerSim(CLI::App& app) {
   auto o = std::make_shared<SimOptions>();
   cmd->add_option("--scenario", o->scenario, "Scenario: " + joined(sim::scenarioNames()))->required();
   cmd->add_option("--out", o->out, "Output folder (written as OUT.partial, renamed when complete)")->required();
-  cmd->add_option("--seed", o->seed, "Random seed: the same seed gives byte-identical output")->capture_default_str();
-  cmd->add_option("--duration", o->duration, "Seconds to simulate (0 = the scenario's natural length)");
+  addSeed(cmd, "--seed", o->seed, "Random seed in [0, 2^64 - 1]: the same seed gives byte-identical output")
+      ->default_str("1");
+  addSeconds(cmd, "--duration", o->duration, between(0, io::kMaxSimDurationS, "s"),
+             "Seconds to simulate, up to 3600 (0 = the scenario's natural length; longer: closed courses lap)");
   cmd->add_option("--lidar", o->lidar, "Lidar model (default vlp16 or the config's)")
       ->check(CLI::IsMember({"vlp16", "vlp32", "hdl64"}));
-  cmd->add_option("--camera-rate", o->camera_rate, "Camera frame rate [Hz] (default 15 or the config's)");
+  cmd->add_option_function<std::string>(
+      "--camera-rate",
+      [o](const std::string& text) {
+        const io::ValueSource source = io::ValueSource::option("--camera-rate");
+        o->camera_rate = io::checkedRate(io::parseNumber(text, source), io::kMaxSimCameraRateHz, source);
+      },
+      "Camera frame rate [Hz], up to 60 (default 15 or the config's)");
   cmd->add_option("--format", o->format, "Output format")->check(CLI::IsMember({"folder"}))->capture_default_str();
   cmd->add_option("--config", o->config, "Platform config with a sim: section (config/farm_sim.yaml)");
   cmd->add_option("--kitti-poses", o->kitti_poses, "kitti05-replay: KITTI poses file (default ../shared/data)");

@@ -1,6 +1,7 @@
 #include "eval/association.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -30,9 +31,12 @@ class NearestWalk {
   }
 
  private:
+  // |t_j + shift - t| in 128 bits, saturated: stamps (up to 9e9 s) plus a user's offset (up to 4e9 s) may leave
+  // int64 nanoseconds, and a wrapped difference would "match" poses that are centuries apart.
   Time distance(std::size_t j, Time t) const {
-    const Time d = longer_[j].t + shift_ - t;
-    return d < 0 ? -d : d;
+    const __int128 d = static_cast<__int128>(longer_[j].t) + shift_ - t;
+    const __int128 a = d < 0 ? -d : d;
+    return a > std::numeric_limits<Time>::max() ? std::numeric_limits<Time>::max() : static_cast<Time>(a);
   }
   const Trajectory& longer_;
   Time shift_;

@@ -10,6 +10,7 @@
 #include "io/error.hpp"
 #include "io/yaml_section.hpp"
 #include "io/text_parsing.hpp"
+#include "io/user_values.hpp"
 
 namespace drover::io {
 namespace {
@@ -35,8 +36,8 @@ class SectionReader {
   YAML::Node node(const char* key) const { return map_[key]; }
   std::string record(const YAML::Node& node, const std::string& key) const {
     const int line = node.Mark().line;
-    return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key '" +
-           section_ + "." + key + "'";
+    return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key " +
+           echo(section_ + "." + key);
   }
 
   void read(const char* key, std::string& out) const {
@@ -53,21 +54,21 @@ class SectionReader {
   }
   void read(const char* key, int& out, int min, int max) const {
     if (const YAML::Node n = map_[key]) {
-      const std::int64_t v = parseInt64(scalar(n, key), file_, record(n, key));
-      if (v < min || v > max)
-        fail(file_, record(n, key),
-             "value " + std::to_string(v) + " outside [" + std::to_string(min) + ", " + std::to_string(max) + "]");
-      out = static_cast<int>(v);
+      out = static_cast<int>(parseInteger(scalar(n, key), min, max, source(n, key)));
     }
   }
-  void read(const char* key, double& out) const {
-    if (const YAML::Node n = map_[key]) out = parseDouble(scalar(n, key), file_, record(n, key));
+  void read(const char* key, double& out, const Range& range = Range{}) const {
+    if (const YAML::Node n = map_[key]) out = parseNumber(scalar(n, key), range, source(n, key));
+  }
+  // Seconds to Time [ns], checked as an option's seconds are (io/user_values.hpp).
+  void readSeconds(const char* key, Time& out, const Range& range) const {
+    if (const YAML::Node n = map_[key]) out = parseSecondsValue(scalar(n, key), range, source(n, key));
   }
   std::vector<double> numbers(const char* key) const {
     const YAML::Node n = map_[key];
     if (!n.IsSequence()) fail(file_, record(n, key), "expected a list of numbers, found " + describe(n));
     std::vector<double> values;
-    for (const YAML::Node& item : n) values.push_back(parseDouble(scalar(item, key), file_, record(n, key)));
+    for (const YAML::Node& item : n) values.push_back(parseNumber(scalar(item, key), source(n, key)));
     return values;
   }
   void readTransform(const char* key, Eigen::Isometry3d& out) const {
@@ -81,12 +82,13 @@ class SectionReader {
   const std::string& file() const { return file_; }
 
  private:
+  ValueSource source(const YAML::Node& n, const std::string& key) const { return {file_, record(n, key)}; }
   std::string scalar(const YAML::Node& n, const std::string& key) const {
     if (!n.IsScalar()) fail(file_, record(n, key), "expected a number, found " + describe(n));
     return n.Scalar();
   }
   static std::string describe(const YAML::Node& n) {
-    if (n.IsScalar()) return "'" + n.Scalar() + "'";
+    if (n.IsScalar()) return echo(n.Scalar());
     if (n.IsSequence()) return "a list";
     if (n.IsMap()) return "a map";
     return "nothing";
@@ -124,17 +126,15 @@ DistortionModel parseDistortionModel(const SectionReader& s) {
   if (name == "radial-tangential" || name == "radtan") return DistortionModel::kRadialTangential;
   if (name == "equidistant") return DistortionModel::kEquidistant;
   fail(s.file(), s.record(s.node("distortion_model"), "distortion_model"),
-       "unknown distortion model '" + name + "' (expected none, radial-tangential or equidistant)");
+       "unknown distortion model " + echo(name) + " (expected none, radial-tangential or equidistant)");
 }
 
 void readCamera(const SectionReader& s, CameraIntrinsics& cam) {
   s.rejectUnknownKeys({"width", "height", "fx", "fy", "cx", "cy", "distortion_model", "distortion_coeffs"});
   s.read("width", cam.width, 0, 100000);
   s.read("height", cam.height, 0, 100000);
-  for (auto [key, value] : {std::pair{"fx", &cam.fx}, {"fy", &cam.fy}, {"cx", &cam.cx}, {"cy", &cam.cy}}) {
-    s.read(key, *value);
-    if (*value < 0) fail(s.file(), s.record(s.node(key), key), "must not be negative");
-  }
+  for (auto [key, value] : {std::pair{"fx", &cam.fx}, {"fy", &cam.fy}, {"cx", &cam.cx}, {"cy", &cam.cy}})
+    s.read(key, *value, atLeast(0, "px"));
   cam.distortion = parseDistortionModel(s);
   if (s.has("distortion_coeffs")) cam.distortion_coeffs = s.numbers("distortion_coeffs");
   const std::size_t n = cam.distortion_coeffs.size();
@@ -152,12 +152,8 @@ void readCalibration(const SectionReader& s, Calibration& c) {
   s.readTransform("T_imu_lidar", c.T_imu_lidar);
   s.readTransform("T_imu_cam", c.T_imu_cam);
   for (auto [key, value] : {std::pair{"lidar_time_offset", &c.lidar_time_offset},
-                            {"camera_time_offset", &c.camera_time_offset}}) {
-    double seconds = 0;
-    s.read(key, seconds);
-    if (std::abs(seconds) > 3600) fail(s.file(), s.record(s.node(key), key), "time offset beyond one hour");
-    *value = fromSeconds(seconds);
-  }
+                            {"camera_time_offset", &c.camera_time_offset}})
+    s.readSeconds(key, *value, between(-3600, 3600, "s"));  // one hour either way
   if (s.has("camera")) {
     const YAML::Node cam = s.node("camera");
     if (!cam.IsMap()) fail(s.file(), s.record(cam, "camera"), "expected a map of camera settings");
@@ -195,7 +191,7 @@ DatasetOptions loadDatasetOptions(const std::string& yaml_path) {
   for (const auto& kv : root) {
     const std::string name = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), name) == known.end())
-      fail(yaml_path, lineRecord(static_cast<std::size_t>(kv.first.Mark().line + 1)) + ", section '" + name + "'",
+      fail(yaml_path, lineRecord(static_cast<std::size_t>(kv.first.Mark().line + 1)) + ", section " + echo(name),
            "unknown section (expected dataset, calibration, sim, odometry, loop or visual)");
   }
   DatasetOptions options;

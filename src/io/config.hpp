@@ -9,11 +9,13 @@
 //     T_imu_lidar, T_imu_cam: 16 numbers, a row-major 4x4 rigid transform [m]
 //     camera: {width, height [px], fx, fy, cx, cy [px], distortion_model: none | radial-tangential |
 //              equidistant, distortion_coeffs: [k1, k2, p1, p2(, k3)] or [k1, k2, k3, k4]}
-//     lidar_time_offset, camera_time_offset: [s], t_imu = t_sensor + offset
+//     lidar_time_offset, camera_time_offset: [s] within +-3600, t_imu = t_sensor + offset
 //
 // The other top-level sections (`sim:`, `odometry:`) belong to other modules and are read by them; any other
 // top-level name is an error naming its line (a misspelt section must not silently fall back to defaults). Inside these two sections an unknown
-// key is an error naming it (a typo must not silently fall back to a default), as is a value of the wrong type.
+// key is an error naming it (a typo must not silently fall back to a default), as is a value of the wrong type. In
+// every section a key written twice, and a section written twice, are errors naming both lines; numbers go through
+// io/user_values.hpp as the command-line options do.
 #include <Eigen/Geometry>
 #include <string>
 #include <vector>

@@ -10,14 +10,15 @@
 #include "io/yaml_section.hpp"
 #include "io/sim_dataset.hpp"
 #include "io/text_parsing.hpp"
+#include "io/user_values.hpp"
 
 namespace drover::io {
 namespace {
 
 std::string keyRecord(const YAML::Node& n, const std::string& key) {
   const int line = n.Mark().line;
-  return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key 'sim." + key +
-         "'";
+  return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key " +
+         echo("sim." + key);
 }
 
 std::string scalar(const YAML::Node& n, const std::string& key, const std::string& file) {
@@ -25,10 +26,14 @@ std::string scalar(const YAML::Node& n, const std::string& key, const std::strin
   return n.Scalar();
 }
 
-double positiveNumber(const YAML::Node& n, const std::string& key, const std::string& file) {
-  const double v = parseDouble(scalar(n, key, file), file, keyRecord(n, key));
-  if (!(v > 0)) fail(file, keyRecord(n, key), "must be positive");
-  return v;
+ValueSource source(const YAML::Node& n, const std::string& key, const std::string& file) {
+  return {file, keyRecord(n, key)};
+}
+
+// A rate key [Hz], checked as `drover sim`'s options are (io/user_values.hpp).
+double rate(const YAML::Node& n, const std::string& key, const std::string& file, double max_hz) {
+  const ValueSource src = source(n, key, file);
+  return checkedRate(parseNumber(scalar(n, key, file), src), max_hz, src);
 }
 
 bool boolean(const YAML::Node& n, const std::string& key, const std::string& file) {
@@ -42,32 +47,30 @@ void readKey(const YAML::Node& n, const std::string& key, const std::string& fil
   if (key == "lidar_model") {
     const std::string m = scalar(n, key, file);
     if (m != "vlp16" && m != "vlp32" && m != "hdl64")
-      fail(file, keyRecord(n, key), "unknown lidar '" + m + "' (expected vlp16, vlp32 or hdl64)");
+      fail(file, keyRecord(n, key), "unknown lidar " + echo(m) + " (expected vlp16, vlp32 or hdl64)");
     s.lidar_model = m;
   } else if (key == "lidar_columns") {
-    const std::int64_t c = parseInt64(scalar(n, key, file), file, keyRecord(n, key));
-    if (c < 1 || c > 100000) fail(file, keyRecord(n, key), "expected 1..100000 columns");
-    s.lidar_columns = static_cast<int>(c);
+    s.lidar_columns = static_cast<int>(parseInteger(scalar(n, key, file), 1, 100000, source(n, key, file)));
   } else if (key == "lidar_time_offset" || key == "camera_time_offset") {
-    const double v = parseDouble(scalar(n, key, file), file, keyRecord(n, key));
-    if (std::abs(v) > 1.0) fail(file, keyRecord(n, key), "time offset beyond one second");
+    Range r{-kMaxSimTimeOffsetS, kMaxSimTimeOffsetS};
+    r.unit = "s";
+    const double v = parseNumber(scalar(n, key, file), source(n, key, file));
+    checkedSeconds(v, r, source(n, key, file));
     (key == "lidar_time_offset" ? s.lidar_time_offset_s : s.camera_time_offset_s) = v;
   } else if (key == "camera_color") {
     s.camera_color = boolean(n, key, file);
   } else if (key == "noise") {
     s.noise = boolean(n, key, file);
   } else if (key == "ground_truth_rate_hz") {
-    s.ground_truth_rate_hz = positiveNumber(n, key, file);
-    if (*s.ground_truth_rate_hz < 100) fail(file, keyRecord(n, key), "must be >= 100 Hz");
+    Range r{kMinSimGroundTruthRateHz, kMaxSimGroundTruthRateHz};
+    r.unit = "Hz";
+    s.ground_truth_rate_hz = parseNumber(scalar(n, key, file), r, source(n, key, file));
+  } else if (key == "lidar_rate_hz") {
+    s.lidar_rate_hz = rate(n, key, file, kMaxSimLidarRateHz);
+  } else if (key == "camera_rate_hz") {
+    s.camera_rate_hz = rate(n, key, file, kMaxSimCameraRateHz);
   } else {
-    const double v = positiveNumber(n, key, file);
-    if (key == "lidar_rate_hz") {
-      s.lidar_rate_hz = v;
-    } else if (key == "camera_rate_hz") {
-      s.camera_rate_hz = v;
-    } else {
-      s.imu_rate_hz = v;  // the only key left of `known`
-    }
+    s.imu_rate_hz = rate(n, key, file, kMaxSimImuRateHz);  // the only key left of `known`
   }
 }
 

@@ -174,6 +174,18 @@ class SimDatasetWriter {
 
 // The `sim:` section of a platform config (config/farm_sim.yaml): sensor settings for `drover sim`. Keys left out
 // keep the simulator's defaults; an unknown key or a bad value throws IoError naming file, line and key.
+// Limits of what `drover sim` generates, shared by its options and the `sim:` keys (io/user_values.hpp checks
+// both). The simulator holds the whole IMU stream, the schedule, the ground truth and the path (a sample every
+// 0.1 s) in memory before the first file is written, so memory grows with duration x rate: an hour at these
+// maxima is about 1 GB. Longer than its natural length a closed course is driven again lap after lap.
+constexpr double kMaxSimDurationS = 3600;      // [s]
+constexpr double kMaxSimImuRateHz = 1000;      // [Hz]
+constexpr double kMaxSimLidarRateHz = 50;      // [Hz]; spinning lidars turn at 5..20 Hz
+constexpr double kMaxSimCameraRateHz = 60;     // [Hz]; the 10 ms exposure also needs rate < 100 Hz
+constexpr double kMinSimGroundTruthRateHz = 100;   // [Hz]
+constexpr double kMaxSimGroundTruthRateHz = 1000;  // [Hz]
+constexpr double kMaxSimTimeOffsetS = 1;       // [s] |lidar_time_offset|, |camera_time_offset|
+
 struct SimConfigSettings {
   std::optional<std::string> lidar_model;        // vlp16 | vlp32 | hdl64
   std::optional<double> lidar_rate_hz;           // [Hz]

@@ -91,8 +91,8 @@ double parseDouble(std::string_view token, const std::string& file, const std::s
   double value = 0;
   const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-    fail(file, record, "not a number: '" + std::string(token) + "'");
-  if (!std::isfinite(value)) fail(file, record, "non-finite value '" + std::string(token) + "'");
+    fail(file, record, "not a number: " + echo(token));
+  if (!std::isfinite(value)) fail(file, record, "non-finite value " + echo(token));
   return value;
 }
 
@@ -102,7 +102,7 @@ std::int64_t parseInt64(std::string_view token, const std::string& file, const s
   std::int64_t value = 0;
   const auto [ptr, ec] = std::from_chars(s.data(), s.data() + s.size(), value);
   if (s.empty() || ec != std::errc() || ptr != s.data() + s.size())
-    fail(file, record, "not an integer: '" + std::string(token) + "'");
+    fail(file, record, "not an integer: " + echo(token));
   return value;
 }
 
@@ -125,7 +125,7 @@ bool isPlainDecimal(std::string_view s) {
 Time parseSeconds(std::string_view token, const std::string& file, const std::string& record) {
   if (!isPlainDecimal(token)) {
     const double s = parseDouble(token, file, record);
-    if (std::abs(s) > 9.0e9) fail(file, record, "time out of range: '" + std::string(token) + "'");
+    if (std::abs(s) > 9.0e9) fail(file, record, "time out of range: " + echo(token));
     return fromSeconds(s);
   }
   const bool negative = token.front() == '-';
@@ -133,10 +133,10 @@ Time parseSeconds(std::string_view token, const std::string& file, const std::st
   const std::size_t dot = s.find('.');
   const std::string_view whole = s.substr(0, dot);
   const std::string_view frac = dot == std::string_view::npos ? std::string_view() : s.substr(dot + 1);
-  if (whole.size() > 10) fail(file, record, "time out of range: '" + std::string(token) + "'");
+  if (whole.size() > 10) fail(file, record, "time out of range: " + echo(token));
   Time seconds = 0;
   for (char c : whole) seconds = seconds * 10 + (c - '0');
-  if (seconds > 9'000'000'000) fail(file, record, "time out of range: '" + std::string(token) + "'");
+  if (seconds > 9'000'000'000) fail(file, record, "time out of range: " + echo(token));
   Time nanos = 0;
   for (std::size_t i = 0; i < 9; ++i) nanos = nanos * 10 + (i < frac.size() ? frac[i] - '0' : 0);
   if (frac.size() > 9 && frac[9] >= '5') ++nanos;  // round half up on the 10th decimal

@@ -14,8 +14,11 @@ class Node;
 
 namespace drover::io {
 
+struct Range;
+
 // The top level of a platform config file (config/*.yaml): a null node for an empty file, else a map. Throws IoError
-// naming the file for a missing file, invalid YAML (with its line) or a top level that is not a map. Shared by every
+// naming the file for a missing file, a folder, invalid YAML (with its line), a key or section written twice in one map
+// (with both lines) or a top level that is not a map. Shared by every
 // reader of a config section (dataset, sim, odometry, loop, visual).
 YAML::Node loadConfigRoot(const std::string& yaml_path);
 
@@ -27,6 +30,8 @@ class YamlSection {
   YamlSection& bind(const std::string& key, int& value);
   YamlSection& bind(const std::string& key, bool& value);
   YamlSection& bind(const std::string& key, std::string& value);
+  // Seconds that the core turns into Time [ns]: within `range` and convertible (io/user_values.hpp).
+  YamlSection& bindSeconds(const std::string& key, double& seconds, const Range& range);
   // A string that must be one of `allowed`; otherwise an IoError naming the line, the key and the allowed values.
   YamlSection& bindChoice(const std::string& key, std::string& value, std::vector<std::string> allowed);
   // A nested section, read by `read` (which binds its own keys on the YamlSection it is given).

@@ -180,6 +180,19 @@ TEST(EvalCli, BadInputExitsWithCodeTwoAndOneClearLine) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
 }
 
+TEST(EvalCli, TimeOptionsBeyondTheLargestTimeAreErrorsNotAnOverflow) {
+  // --t-offset 1e10 overflowed to 0 s in the seconds -> nanoseconds conversion, so every pose "matched".
+  LineFixture late(1.0);
+  for (const char* option : {"--t-offset", "--t-max-diff"}) {
+    const CliResult r = runDrover("eval ape " + late.files() + " " + option + " 1e10");
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, std::string("[error] ") + option + ": 10000000000 s is beyond the largest time"))
+        << r.output;
+    EXPECT_EQ(countLinesWith(r.output, "[error]"), 1u) << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(late.json));
+}
+
 TEST(EvalCli, TooFewMatchesExitWithCodeTwo) {
   LineFixture late(1.0);  // the estimate's clock runs 1 s late: nothing within 10 ms
   CliResult r = runDrover("eval ape " + late.ref.string() + " " + late.est.string());

@@ -285,6 +285,28 @@ TEST(OdometryConfigReader, AFractionForAnIntegerAndAnOutOfRangeIntegerAreErrors)
   EXPECT_TRUE(has(r, "'odometry.layout.n_rings'") && has(r, "out of range")) << r;
 }
 
+TEST(OdometryConfigReader, AKeyWrittenTwiceIsAnErrorNotTheLastValue) {
+  test::TempDir dir;
+  const std::string e = errorOf(dir, "odometry:\n  matcher:\n    max_iterations: 5\n    max_iterations: 30\n");
+  EXPECT_TRUE(has(e, "line 4, key 'odometry.matcher.max_iterations'") && has(e, "duplicate key (first at line 3)"))
+      << e;
+}
+
+TEST(OdometryConfigReader, ASectionWrittenTwiceIsAnErrorNotIgnored) {
+  test::TempDir dir;
+  const std::string e = errorOf(dir, "loop:\n  enabled: true\nodometry:\n  use_imu: true\nloop:\n  enabled: false\n");
+  EXPECT_TRUE(has(e, "line 5, section 'loop'") && has(e, "duplicate section (first at line 1)")) << e;
+}
+
+TEST(OdometryConfigReader, SecondsKeysMustConvertToNanosecondsWithoutOverflow) {
+  test::TempDir dir;
+  // 1e10 s overflowed int64 nanoseconds in the core's fromSeconds.
+  const std::string e = errorOf(dir, "loop:\n  min_age: 1e10\n");
+  EXPECT_TRUE(has(e, "line 2, key 'loop.min_age'") && has(e, "beyond the largest time")) << e;
+  const std::string n = errorOf(dir, "odometry:\n  imu_wait: -1\n");
+  EXPECT_TRUE(has(n, "'odometry.imu_wait'") && has(n, "expected [0, inf] s")) << n;
+}
+
 TEST(OdometryConfigReader, MaybeForABoolIsAnErrorAskingForTrueOrFalse) {
   test::TempDir dir;
   const std::string e = errorOf(dir, "odometry:\n  layout:\n    order_top_down: maybe\n");

@@ -2,6 +2,7 @@
 // exit 2 with one clear line.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -93,6 +94,43 @@ TEST(SimCli, BadArgumentsExitWithCode2) {
   EXPECT_EQ(runDrover("sim --scenario straight --format bag" + out).exit_code, 2);
   EXPECT_EQ(runDrover("sim --scenario straight --camera-rate 500 --duration 1" + out).exit_code, 2);
   EXPECT_EQ(runDrover("sim --scenario straight").exit_code, 2);  // --out missing
+  EXPECT_FALSE(fs::exists(dir / "x"));
+}
+
+TEST(SimCli, ADurationBeyondAnHourIsRefusedAtOnceWithTheValidRange) {
+  // 1e9 s used to grow the path in memory at 130 MB/s without a word; 1e12 s overflowed into "too short".
+  TempDir dir;
+  for (const char* d : {"1e9", "1e12", "3600.5"}) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const CliResult r = runDrover(std::string("sim --scenario farm --no-camera --duration ") + d + " --out " +
+                                  (dir / "farm").string());
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "[error] --duration:")) << r.output;
+    EXPECT_TRUE(contains(r.output, "(expected [0, 3600] s)")) << r.output;
+    EXPECT_LT(wall, 10.0) << d;
+  }
+  EXPECT_FALSE(fs::exists(dir / "farm"));
+  EXPECT_FALSE(fs::exists(dir / "farm.partial"));
+}
+
+TEST(SimCli, CameraRateZeroIsAnErrorNotTheDefault) {
+  TempDir dir;
+  const CliResult r =
+      runDrover("sim --scenario straight --duration 1 --camera-rate 0 --out " + (dir / "x").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "--camera-rate: 0 Hz is out of range (expected (0, 60] Hz)")) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "x"));
+}
+
+TEST(SimCli, SeedsOutsideSixtyFourBitsAreErrorsNotTheLargestSeed) {
+  TempDir dir;
+  for (const char* seed : {"-1", "18446744073709551616", "1180591620717411303424"}) {
+    const CliResult r = runDrover(std::string("sim --scenario straight --duration 1 --seed ") + seed + " --out " +
+                                  (dir / "x").string());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(contains(r.output, "--seed:")) << r.output;
+  }
   EXPECT_FALSE(fs::exists(dir / "x"));
 }
 

@@ -34,6 +34,16 @@ TEST(Association, MaxDiffBoundaryIsInclusive) {
   EXPECT_EQ(a.second, (Idx{0}));
 }
 
+TEST(Association, AnOffsetThatLeavesInt64NanosecondsNeverMatchesPosesCenturiesApart) {
+  // 9e9 s (the readers' largest stamp) + a 4e9 s offset (the CLI's largest) is beyond int64 ns; wrapped, the
+  // difference to a stamp of -5.4e9 s would come out as 0 and pair them.
+  const Time t = -5'446'744'073'709'551'616;  // 9e18 + 4e18 - 2^64 [ns]
+  const Association a = associate(stamps({t}), stamps({9'000'000'000'000'000'000 - 1, 9'000'000'000'000'000'000}),
+                                  {10 * kMs, 4'000'000'000'000'000'000});
+  EXPECT_TRUE(a.first.empty());
+  EXPECT_EQ(a.max_pairs, 1u);
+}
+
 TEST(Association, IteratesTheShorterTrajectoryAndMayReuseAPoseOfTheLonger) {
   // first (longer): 0, 10, 20, 30 ms; second (shorter): 9, 11 ms. Both second stamps are nearest to 10 ms.
   const Association a = associate(stamps({0, 10 * kMs, 20 * kMs, 30 * kMs}), stamps({9 * kMs, 11 * kMs}),

@@ -182,7 +182,7 @@ TEST(Config, RejectsWrongTypesNamingFileAndKey) {
   msg = errorOf("dataset:\n  kitti_camera: left\n");
   EXPECT_TRUE(contains(msg, "key 'dataset.kitti_camera'")) << msg;
   msg = errorOf("dataset:\n  kitti_camera: 7\n");
-  EXPECT_TRUE(contains(msg, "outside [0, 3]")) << msg;
+  EXPECT_TRUE(contains(msg, "out of range (expected an integer in [0, 3])")) << msg;
   msg = errorOf("dataset:\n  lidar_topic: [/a, /b]\n");
   EXPECT_TRUE(contains(msg, "key 'dataset.lidar_topic'")) << msg;
   msg = errorOf("calibration:\n  camera:\n    fx: [1, 2]\n");
@@ -211,6 +211,57 @@ TEST(Config, RejectsDistortionCoefficientsThatDoNotFitTheModel) {
   EXPECT_TRUE(contains(msg, "2 coefficients do not fit")) << msg;
   EXPECT_TRUE(contains(errorOf("calibration:\n  camera:\n    distortion_model: fisheye\n"),
                        "unknown distortion model 'fisheye'"));
+}
+
+TEST(Config, AFolderGivenAsTheConfigIsAnErrorNotTheDefaults) {
+  test::TempDir dir;
+  try {
+    loadDatasetOptions(dir.path().string());
+    ADD_FAILURE() << "a folder loaded as a config";
+  } catch (const IoError& e) {
+    EXPECT_TRUE(contains(e.what(), dir.path().string())) << e.what();
+    EXPECT_TRUE(contains(e.what(), "is a folder")) << e.what();
+  }
+}
+
+TEST(Config, AKeyWrittenTwiceIsAnErrorNamingBothLines) {
+  const std::string msg = errorOf("dataset:\n  load_imu: false\n  load_lidar: true\n  load_imu: true\n");
+  EXPECT_TRUE(contains(msg, "line 4, key 'dataset.load_imu'")) << msg;
+  EXPECT_TRUE(contains(msg, "duplicate key (first at line 2)")) << msg;
+  const std::string nested =
+      errorOf("calibration:\n  camera:\n    fx: 500\n    fy: 500\n    fx: 400\n");
+  EXPECT_TRUE(contains(nested, "line 5, key 'calibration.camera.fx'")) << nested;
+}
+
+TEST(Config, ASectionWrittenTwiceIsAnErrorNamingBothLines) {
+  const std::string msg = errorOf("dataset:\n  load_imu: false\nsim:\n  noise: false\ndataset:\n  load_imu: true\n");
+  EXPECT_TRUE(contains(msg, "line 5, section 'dataset'")) << msg;
+  EXPECT_TRUE(contains(msg, "duplicate section (first at line 1)")) << msg;
+}
+
+TEST(Config, DuplicateKeysInSectionsOfOtherModulesAreCaughtToo) {
+  // loadConfigRoot is shared by every section's reader, so the dataset reader also sees odometry's duplicates.
+  const std::string msg = errorOf("odometry:\n  matcher:\n    neighbors: 5\n    neighbors: 6\n");
+  EXPECT_TRUE(contains(msg, "line 4, key 'odometry.matcher.neighbors'")) << msg;
+}
+
+TEST(Config, TimeOffsetsAreCheckedSecondsNamingTheRange) {
+  const std::string msg = errorOf("calibration:\n  camera_time_offset: 1e10\n");
+  EXPECT_TRUE(contains(msg, "line 2, key 'calibration.camera_time_offset'")) << msg;
+  EXPECT_TRUE(contains(msg, "expected [-3600, 3600] s")) << msg;
+  for (const char* nan : {".nan", "nan", "-inf"}) {
+    const std::string e = errorOf(std::string("calibration:\n  lidar_time_offset: ") + nan + "\n");
+    EXPECT_TRUE(contains(e, "key 'calibration.lidar_time_offset'") && contains(e, nan)) << e;
+  }
+}
+
+TEST(Config, AHugeValueIsEchoedShortened) {
+  const std::string huge(1'000'000, 'x');
+  const std::string msg = errorOf("dataset:\n  load_imu: " + huge + "\n");
+  EXPECT_LT(msg.size(), 400u) << msg.substr(0, 400);
+  EXPECT_TRUE(contains(msg, "(1000000 characters)")) << msg.substr(0, 400);
+  const std::string key = errorOf("dataset:\n  " + huge + ": 1\n");
+  EXPECT_LT(key.size(), 600u) << key.substr(0, 600);
 }
 
 }  // namespace

@@ -396,6 +396,20 @@ TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
   expectIoError([&] { loadSimConfigSettings((tmp / "c.yaml").string()); }, {"c.yaml", "vlp17"});
 }
 
+TEST(SimConfigSettings, RatesAndOffsetsShareTheOptionsRanges) {
+  TempDir tmp;
+  const auto error = [&](const std::string& text, std::initializer_list<std::string> fragments) {
+    test::writeText(tmp / "s.yaml", "sim:\n  " + text + "\n");
+    expectIoError([&] { loadSimConfigSettings((tmp / "s.yaml").string()); }, fragments);
+  };
+  error("imu_rate_hz: 1e9", {"s.yaml (line 2, key 'sim.imu_rate_hz')", "(0, 1000] Hz"});
+  error("camera_rate_hz: 0", {"key 'sim.camera_rate_hz'", "(0, 60] Hz"});
+  error("lidar_rate_hz: .nan", {"key 'sim.lidar_rate_hz'"});
+  error("ground_truth_rate_hz: 50", {"[100, 1000] Hz"});
+  error("lidar_time_offset: 2", {"key 'sim.lidar_time_offset'", "[-1, 1] s"});
+  error("lidar_columns: 0", {"key 'sim.lidar_columns'", "[1, 100000]"});
+}
+
 TEST(SimConfigSettings, FarmSimConfigIsAValidPlatformAndSimConfig) {
   const std::string path = std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml";
   EXPECT_NO_THROW(loadDatasetOptions(path));

@@ -1,5 +1,7 @@
 #include "io/odometry/loop_config_io.hpp"
 
+#include "io/user_values.hpp"
+
 namespace drover::io {
 
 void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStrings& e) {
@@ -8,7 +10,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
   s.bind("enabled", c.enabled)
       .bindChoice("source", e.source, {"scancontext", "radius", "both"})
       .bind("yaw_prior", c.yaw_prior)
-      .bind("min_age", c.min_age)
+      .bindSeconds("min_age", c.min_age, atLeast(0, "s"))
       .bind("submap_keyframes", c.submap_keyframes)
       .bind("max_verifications", c.max_verifications)
       .bind("skip_after_loop", c.skip_after_loop)

@@ -8,6 +8,7 @@
 #include "io/error.hpp"
 #include "io/odometry/loop_config_io.hpp"
 #include "io/text_parsing.hpp"
+#include "io/user_values.hpp"
 #include "io/yaml_section.hpp"
 
 namespace drover::io {
@@ -23,7 +24,7 @@ void bindLayout(YamlSection& s, lidar::ScanLayoutConfig& c, EnumStrings& e) {
       .bind("vertical_fov_min_deg", c.vertical_fov_min_deg)
       .bind("vertical_fov_max_deg", c.vertical_fov_max_deg)
       .bind("columns", c.columns)
-      .bind("scan_period", c.scan_period)
+      .bindSeconds("scan_period", c.scan_period, positive("s"))
       .bindChoice("spin", e.spin, {"ccw", "cw"})
       .bindChoice("ring_source", e.ring_source, {"elevation", "order"})
       .bind("order_top_down", c.order_top_down)
@@ -126,7 +127,7 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
   top.bind("use_imu", c.use_imu)
       .bind("deskew", c.deskew)
       .bind("min_points", c.min_points)
-      .bind("imu_wait", c.imu_wait)
+      .bindSeconds("imu_wait", c.imu_wait, atLeast(0, "s"))
       .bind("lidar_sigma_position", c.lidar_sigma_position)
       .bind("lidar_sigma_rotation", c.lidar_sigma_rotation)
       .bind("degenerate_sigma", c.degenerate_sigma)

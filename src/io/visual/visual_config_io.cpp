@@ -7,6 +7,7 @@
 #include "io/config.hpp"
 #include "io/error.hpp"
 #include "io/text_parsing.hpp"
+#include "io/user_values.hpp"
 #include "io/yaml_section.hpp"
 
 namespace drover::io {
@@ -68,7 +69,7 @@ void bindTracker(YamlSection& s, visual::FeatureTrackerConfig& c, std::string& c
 }
 
 void bindDepth(YamlSection& s, visual::DepthAssociationConfig& c) {
-  s.bind("window_s", c.window_s)
+  s.bindSeconds("window_s", c.window_s, positive("s"))
       .bind("voxel_size", c.voxel_size)
       .bind("grid_resolution_deg", c.grid_resolution_deg)
       .bind("neighbour_cells", c.neighbour_cells)
