@@ -81,7 +81,7 @@ TEST(ReadmePromises, QuietPrintsNothingOnGoodInputForEveryCommand) {
   const std::string tum = (dir / "traj" / "traj.tum").string(), scan = (seq / "velodyne" / "000000.bin").string();
   for (const std::string& args :
        {"info " + seq.string() + " --format kitti -q",
-        "sim --scenario straight --duration 0.3 --no-camera --out " + (dir / "sim").string() + " -q",
+        "sim --scenario straight --duration 0.5 --camera-rate 10 --out " + (dir / "sim").string() + " -q",
         runKitti(seq, dir / "run") + " --max-frames 2 -q", "eval ape " + tum + " " + tum + " -q",
         "loop pair " + scan + " " + scan + " -q", "loop eval " + seq.string() + " --format kitti -q",
         "graph optimize " + (dir / "g.g2o").string() + " " + (dir / "o.g2o").string() + " -q",
@@ -196,7 +196,7 @@ class SimImuPromise : public ::testing::Test {
     const fs::path copy = *dir_ / name;
     fs::remove_all(copy);
     fs::copy(*dir_ / "ds", copy, fs::copy_options::recursive);
-    std::istringstream in(fuzz::readText(*dir_ / "ds" / "imu.csv"));
+    std::istringstream in(readText(*dir_ / "ds" / "imu.csv"));
     std::string out;
     for (std::string l; std::getline(in, l);) {
       if (l.empty() || l[0] == '#' || l[0] == 't') {
@@ -253,7 +253,7 @@ TEST_F(SimImuPromise, AnImuSpikeIsDroppedCountedAndWarned) {
 // "sweeps whose stamp does not advance are skipped ... each with a warning" (issue 14, item 9: readers stop instead)
 TEST_F(SimImuPromise, ASweepWhoseStampDoesNotAdvanceIsSkippedWithAWarning) {
   const fs::path ds = editedCopy("stamp", [](long long, const std::string& row) { return row; });
-  std::istringstream in(fuzz::readText(ds / "lidar" / "timestamps.csv"));
+  std::istringstream in(readText(ds / "lidar" / "timestamps.csv"));
   std::vector<std::string> rows;
   for (std::string l; std::getline(in, l);) rows.push_back(l);
   ASSERT_GT(rows.size(), 12u);

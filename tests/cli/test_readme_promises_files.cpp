@@ -32,7 +32,7 @@ void expectOneError(const CliResult& r, std::initializer_list<std::string> fragm
 TEST(ReadmePromisesFiles, AKittiScanWhoseSizeIsNotAMultipleOf16BytesIsAnErrorNamingIt) {
   TempDir dir;
   fuzz::writeKittiSequence(dir / "00", 3, 4, 16);
-  const std::string bin = fuzz::readText(dir / "00" / "velodyne" / "000001.bin");
+  const std::string bin = readText(dir / "00" / "velodyne" / "000001.bin");
   writeText(dir / "00" / "velodyne" / "000001.bin", bin.substr(0, bin.size() - 3));
   expectOneError(runDrover("info " + (dir / "00").string() + " --format kitti"), {"000001.bin"});
 }
@@ -42,7 +42,7 @@ class G2oPromise : public ::testing::Test {
   // The fixture graph with `line` appended (or, with replace, its first line replaced by it).
   CliResult optimize(const std::string& line, bool replace = false) {
     fuzz::writeG2oGraph(dir_ / "in.g2o");
-    std::string g = fuzz::readText(dir_ / "in.g2o");
+    std::string g = readText(dir_ / "in.g2o");
     if (replace) g = line + "\n" + g.substr(g.find('\n') + 1);
     else g += line + "\n";
     writeText(dir_ / "in.g2o", g);
@@ -139,7 +139,7 @@ TEST(ReadmePromisesFiles, AMissingOrMalformedWeightsFileIsAnErrorNamingIt) {
 TEST(ReadmePromisesFiles, ABadOdometryValueNamesTheConfigAndItsLine) {
   TempDir dir;
   fuzz::writeKittiSequence(dir / "00", 2, 4, 16);
-  std::string yaml = fuzz::readText(config("kitti.yaml"));
+  std::string yaml = readText(config("kitti.yaml"));
   const std::size_t at = yaml.find("  use_imu: false");
   ASSERT_NE(at, std::string::npos);
   const std::size_t line = static_cast<std::size_t>(std::count(yaml.begin(), yaml.begin() + at, '\n')) + 1;

@@ -30,8 +30,8 @@ enum class Expect {
 struct CliCase {
   std::string args;                  // after `drover`; {placeholders} expanded
   Expect expect = Expect::kEither;
-  std::string names;                 // the [error] line must contain this ({placeholders} expanded)
-  std::vector<std::string> outputs;  // files a success writes ({placeholders} expanded)
+  std::string names = "";            // the [error] line must contain this ({placeholders} expanded)
+  std::vector<std::string> outputs = {};  // files a success writes ({placeholders} expanded)
   int timeout_s = 30;
 };
 

