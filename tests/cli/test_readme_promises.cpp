@@ -135,8 +135,8 @@ TEST(ReadmePromises, SimForceRefusesToReplaceAFolderThatIsNotADataset) {
 TEST(ReadmePromises, AKilledSimLeavesNoFolderThatLooksLikeADataset) {
   TempDir dir;
   const fs::path out = dir / "farm";
-  const std::string cmd = "timeout -s KILL 2 " + std::string(DROVER_BINARY) +
-                          " sim -q --scenario farm --out " + out.string() + " > /dev/null 2>&1";
+  const std::string cmd = "timeout -s KILL 2 " + std::string(DROVER_BINARY) + " sim -q --scenario farm --out " +
+                          out.string() + " > /dev/null 2>&1";
   ASSERT_NE(std::system(cmd.c_str()), 0) << "the farm course should take longer than 2 s";
   EXPECT_FALSE(fs::exists(out)) << "a killed sim left " << out;
 }

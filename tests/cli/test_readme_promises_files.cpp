@@ -25,7 +25,8 @@ void expectOneError(const CliResult& r, std::initializer_list<std::string> fragm
   for (std::string l; std::getline(in, l);)
     if (contains(l, "[error]")) errors.push_back(l);
   ASSERT_EQ(errors.size(), 1u) << r.output;
-  for (const std::string& f : fragments) EXPECT_TRUE(contains(errors[0], f)) << "should name " << f << ": " << errors[0];
+  for (const std::string& f : fragments)
+    EXPECT_TRUE(contains(errors[0], f)) << "should name " << f << ": " << errors[0];
 }
 
 // KITTI table: "`.bin` = float32 x, y, z, reflectance (size must be a multiple of 16 bytes)"
@@ -43,8 +44,10 @@ class G2oPromise : public ::testing::Test {
   CliResult optimize(const std::string& line, bool replace = false) {
     fuzz::writeG2oGraph(dir_ / "in.g2o");
     std::string g = readText(dir_ / "in.g2o");
-    if (replace) g = line + "\n" + g.substr(g.find('\n') + 1);
-    else g += line + "\n";
+    if (replace)
+      g = line + "\n" + g.substr(g.find('\n') + 1);
+    else
+      g += line + "\n";
     writeText(dir_ / "in.g2o", g);
     return runDrover("graph optimize " + (dir_ / "in.g2o").string() + " " + (dir_ / "out.g2o").string());
   }

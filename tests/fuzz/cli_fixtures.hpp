@@ -1,10 +1,10 @@
 #pragma once
-// The inputs of the CLI fuzz tables, each written when a case first needs it: {kitti} (a 6-frame KITTI odometry sequence in a
-// box-shaped hall), {kittiraw}, {euroc}, {sim} (a 2 s `drover sim` straight course), {bag} + {bagcfg}, {traj}
-// (trajectory files), {g2o}, {png}, {bigpng} (a header claiming 100000 x 100000 px), {bin} (scans for loop pair),
-// {cfg} (the shipped configs), {weights} (SuperPoint's, from ../shared) and {plain} (a folder that is no dataset);
-// {g2odir}, {pngdir} and {bagdir} are the folders of the single-file fixtures. Also mutatedCopy(): a copy of a fixture
-// with one file mutated, for the tables of mutated inputs.
+// The inputs of the CLI fuzz tables, each written when a case first needs it: {kitti} (a 6-frame KITTI odometry
+// sequence in a box-shaped hall), {kittiraw}, {euroc}, {sim} (a 2 s `drover sim` straight course), {bag} + {bagcfg},
+// {traj} (trajectory files), {g2o}, {png}, {bigpng} (a header claiming 100000 x 100000 px), {bin} (scans for loop
+// pair), {cfg} (the shipped configs), {weights} (SuperPoint's, from ../shared) and {plain} (a folder that is no
+// dataset); {g2odir}, {pngdir} and {bagdir} are the folders of the single-file fixtures. Also mutatedCopy(): a copy of
+// a fixture with one file mutated, for the tables of mutated inputs.
 #include <gtest/gtest.h>
 
 #include <cstring>

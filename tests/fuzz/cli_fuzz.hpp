@@ -28,9 +28,9 @@ enum class Expect {
 };
 
 struct CliCase {
-  std::string args;                  // after `drover`; {placeholders} expanded
+  std::string args;  // after `drover`; {placeholders} expanded
   Expect expect = Expect::kEither;
-  std::string names = "";            // the [error] line must contain this ({placeholders} expanded)
+  std::string names = "";                 // the [error] line must contain this ({placeholders} expanded)
   std::vector<std::string> outputs = {};  // files a success writes ({placeholders} expanded)
   int timeout_s = 30;
 };
@@ -112,8 +112,9 @@ inline void runCliTable(const std::string& what, const std::vector<CliCase>& cas
     const std::string breach = contractBreach(cases[i], r, vars);
     if (breach.empty()) continue;
     ++breaches;
-    std::string shown = r.output.size() > 1500 ? r.output.substr(0, 700) + "\n...\n" + r.output.substr(r.output.size() - 700)
-                                               : r.output;
+    std::string shown = r.output.size() > 1500
+                            ? r.output.substr(0, 700) + "\n...\n" + r.output.substr(r.output.size() - 700)
+                            : r.output;
     report += "\n--- " + breach + " (exit " + std::to_string(r.exit_code) + ")\n  $ drover " + args + "\n" + shown;
   }
   std::cout << "[fuzz] cli " << what << ": " << cases.size() << " cases, " << breaches << " breaches\n";

@@ -96,11 +96,11 @@ inline void writeKittiSequence(const fs::path& seq, int frames = 5, int rings = 
   writeText(seq / "times.txt", times);
   writeText(seq / "poses.txt", poses);
   const std::string p = "718.856 0 607.1928 ";
-  writeText(seq / "calib.txt",
-            "P0: " + p + "0 0 718.856 185.2157 0 0 0 1 0\n" + "P1: " + p + "-386.1448 0 718.856 185.2157 0 0 0 1 0\n" +
-                "P2: " + p + "45.38225 0 718.856 185.2157 -0.1130887 0 0 1 0.003779761\n" + "P3: " + p +
-                "-337.2877 0 718.856 185.2157 2.369057 0 0 1 0.004915215\n"
-                "Tr: 0 -1 0 -0.01 0 0 -1 -0.05 1 0 0 -0.29\n");
+  writeText(seq / "calib.txt", "P0: " + p + "0 0 718.856 185.2157 0 0 0 1 0\n" + "P1: " + p +
+                                   "-386.1448 0 718.856 185.2157 0 0 0 1 0\n" + "P2: " + p +
+                                   "45.38225 0 718.856 185.2157 -0.1130887 0 0 1 0.003779761\n" + "P3: " + p +
+                                   "-337.2877 0 718.856 185.2157 2.369057 0 0 1 0.004915215\n"
+                                   "Tr: 0 -1 0 -0.01 0 0 -1 -0.05 1 0 0 -0.29\n");
 }
 
 inline std::string kittiRawStamp(int centis) {  // "2011-09-30 12:40:SS.ff0000000"
@@ -111,9 +111,11 @@ inline std::string kittiRawStamp(int centis) {  // "2011-09-30 12:40:SS.ff000000
 
 // A KITTI raw sync drive (calibration in the drive folder): 10 oxts records at 10 Hz, 3 scans, 2 images.
 inline void writeKittiRawDrive(const fs::path& drive) {
-  writeText(drive / "calib_imu_to_velo.txt", "calib_time: 25-May-2012 16:47:16\nR: 1 0 0 0 1 0 0 0 1\nT: -0.81 0.32 -0.8\n");
-  writeText(drive / "calib_velo_to_cam.txt", "calib_time: 15-Mar-2012 11:37:16\nR: 0 -1 0 0 0 -1 1 0 0\n"
-                                             "T: -0.004 -0.076 -0.27\ndelta_f: 0 0\ndelta_c: 0 0\n");
+  writeText(drive / "calib_imu_to_velo.txt",
+            "calib_time: 25-May-2012 16:47:16\nR: 1 0 0 0 1 0 0 0 1\nT: -0.81 0.32 -0.8\n");
+  writeText(drive / "calib_velo_to_cam.txt",
+            "calib_time: 15-Mar-2012 11:37:16\nR: 0 -1 0 0 0 -1 1 0 0\n"
+            "T: -0.004 -0.076 -0.27\ndelta_f: 0 0\ndelta_c: 0 0\n");
   writeText(drive / "calib_cam_to_cam.txt",
             "calib_time: 09-Jan-2012 13:57:47\ncorner_dist: 9.950000e-02\nS_00: 1392 512\n"
             "K_00: 984.2 0 690 0 980.8 233.2 0 0 1\nD_00: -0.37 0.2 0.0022 0.0014 -0.072\n"
@@ -126,10 +128,37 @@ inline void writeKittiRawDrive(const fs::path& drive) {
   for (int k = 0; k < 10; ++k) {
     char name[32];
     std::snprintf(name, sizeof(name), "%010d.txt", k);
-    writeText(drive / "oxts" / "data" / name,
-              numbers({49.0 + 1e-6 * k, 8.4 + 1e-5 * k, 110, 0.02, -0.01, 0.3 + 0.02 * k, 1, 2, 10, 0, 0.5, 21, 22,
-                       23, 0.1, 2, 9.81, 11, 12, 13, 0.001, -0.002, 0.2, 0.05, 0.02, 4, 9, 5, 5, 6}) +
-                  "\n");
+    writeText(drive / "oxts" / "data" / name, numbers({49.0 + 1e-6 * k,
+                                                       8.4 + 1e-5 * k,
+                                                       110,
+                                                       0.02,
+                                                       -0.01,
+                                                       0.3 + 0.02 * k,
+                                                       1,
+                                                       2,
+                                                       10,
+                                                       0,
+                                                       0.5,
+                                                       21,
+                                                       22,
+                                                       23,
+                                                       0.1,
+                                                       2,
+                                                       9.81,
+                                                       11,
+                                                       12,
+                                                       13,
+                                                       0.001,
+                                                       -0.002,
+                                                       0.2,
+                                                       0.05,
+                                                       0.02,
+                                                       4,
+                                                       9,
+                                                       5,
+                                                       5,
+                                                       6}) +
+                                                  "\n");
     oxts_stamps += kittiRawStamp(10 * k) + "\n";
   }
   writeText(drive / "oxts" / "timestamps.txt", oxts_stamps);
@@ -162,8 +191,9 @@ inline std::string eurocSensorYaml(bool camera) {
                           : "1.0, 0.0, 0.0, 0.0,\n         0.0, 1.0, 0.0, 0.0,\n") +
                   "         0.0, 0.0, 1.0, 0.0,\n         0.0, 0.0, 0.0, 1.0]\n";
   if (!camera) return y + "rate_hz: 200\n";
-  return y + "rate_hz: 20\nresolution: [4, 3]\ncamera_model: pinhole\nintrinsics: [100.0, 101.0, 2.0, 1.5]\n"
-             "distortion_model: radial-tangential\ndistortion_coefficients: [0.1, -0.01, 0.001, 0.0001]\n";
+  return y +
+         "rate_hz: 20\nresolution: [4, 3]\ncamera_model: pinhole\nintrinsics: [100.0, 101.0, 2.0, 1.5]\n"
+         "distortion_model: radial-tangential\ndistortion_coefficients: [0.1, -0.01, 0.001, 0.0001]\n";
 }
 
 // SEQ/mav0 with imu0 (20 samples at 200 Hz), cam0 (3 PNGs) and the ground-truth CSV.
@@ -259,7 +289,8 @@ inline void writeTrajectories(const fs::path& dir) {
 inline void writeG2oGraph(const fs::path& file) {
   std::string g;
   const std::string info = "100 0 0 0 0 0 100 0 0 0 0 100 0 0 0 400 0 0 400 0 400";
-  for (int i = 0; i < 6; ++i) g += "VERTEX_SE3:QUAT " + std::to_string(i) + " " + numbers({1.0 * i, 0.1 * i, 0, 0, 0, 0, 1}) + "\n";
+  for (int i = 0; i < 6; ++i)
+    g += "VERTEX_SE3:QUAT " + std::to_string(i) + " " + numbers({1.0 * i, 0.1 * i, 0, 0, 0, 0, 1}) + "\n";
   for (int i = 0; i < 5; ++i)
     g += "EDGE_SE3:QUAT " + std::to_string(i) + " " + std::to_string(i + 1) + " 1 0.1 0 0 0 0 1 " + info + "\n";
   g += "EDGE_SE3:QUAT 0 5 5 0.5 0 0 0 0 1 " + info + "\n# a comment\nFIX 0\n";

@@ -30,10 +30,34 @@ class Rng {
 // Text that number parsers and range checks must survive: non-finite, overflowing (double and int64/uint64),
 // denormal, negative, empty, not a number at all.
 inline const std::vector<std::string>& hostileTokens() {
-  static const std::vector<std::string> t = {
-      "nan", "NaN", "-nan", "inf", "-inf", "Infinity", "1e308", "1e309", "-1e309", "4.9e-324", "0", "-0", "-1",
-      "2147483648", "-2147483649", "9223372036854775808", "18446744073709551616",
-      "1180591620717411303424" /* 2^70 */, "1e10", "-1e10", "", "x", "0x1p3", "1,5", "+", ".", "1e", "--1"};
+  static const std::vector<std::string> t = {"nan",
+                                             "NaN",
+                                             "-nan",
+                                             "inf",
+                                             "-inf",
+                                             "Infinity",
+                                             "1e308",
+                                             "1e309",
+                                             "-1e309",
+                                             "4.9e-324",
+                                             "0",
+                                             "-0",
+                                             "-1",
+                                             "2147483648",
+                                             "-2147483649",
+                                             "9223372036854775808",
+                                             "18446744073709551616",
+                                             "1180591620717411303424" /* 2^70 */,
+                                             "1e10",
+                                             "-1e10",
+                                             "",
+                                             "x",
+                                             "0x1p3",
+                                             "1,5",
+                                             "+",
+                                             ".",
+                                             "1e",
+                                             "--1"};
   return t;
 }
 

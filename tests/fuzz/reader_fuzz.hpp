@@ -17,17 +17,17 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
 #include <typeinfo>
-#include <limits>
 #include <variant>
 #include <vector>
 
@@ -39,20 +39,26 @@
 namespace drover::test::fuzz {
 namespace fs = std::filesystem;
 
-constexpr double kCaseTimeout = 10.0;               // [s] a reader slower than this on a tiny fixture hangs
-constexpr std::size_t kMaxMessageChars = 1000;      // an error line is short
-constexpr rlim_t kChildAddressSpace = 2ull << 30;   // [bytes]
+constexpr double kCaseTimeout = 10.0;              // [s] a reader slower than this on a tiny fixture hangs
+constexpr std::size_t kMaxMessageChars = 1000;     // an error line is short
+constexpr rlim_t kChildAddressSpace = 2ull << 30;  // [bytes]
 
 enum class Outcome { kOk, kIoError, kWrong, kOtherException, kSignal, kHang };
 
 inline const char* outcomeName(Outcome o) {
   switch (o) {
-    case Outcome::kOk: return "ok";
-    case Outcome::kIoError: return "IoError";
-    case Outcome::kWrong: return "SILENTLY WRONG";
-    case Outcome::kOtherException: return "OTHER EXCEPTION";
-    case Outcome::kSignal: return "SIGNAL";
-    case Outcome::kHang: return "HANG";
+    case Outcome::kOk:
+      return "ok";
+    case Outcome::kIoError:
+      return "IoError";
+    case Outcome::kWrong:
+      return "SILENTLY WRONG";
+    case Outcome::kOtherException:
+      return "OTHER EXCEPTION";
+    case Outcome::kSignal:
+      return "SIGNAL";
+    case Outcome::kHang:
+      return "HANG";
   }
   return "?";
 }
@@ -76,7 +82,8 @@ inline void writeAll(int fd, const std::string& s) {
   }
 }
 inline void putFile(const std::string& path, const std::string& bytes) {
-  std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  std::ofstream(path, std::ios::binary | std::ios::trunc)
+      .write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 // The child: runs cases [first, end) in turn and sends one record per case: index (8 bytes), outcome code (1),
 // message length (4), message. Its stderr goes to /dev/null (libpng's chatter is not the contract).
@@ -101,7 +108,8 @@ inline void putFile(const std::string& path, const std::string& bytes) {
       code = 'X', message = "unknown exception type";
     }
     putFile(cases[k].path, cases[k].original);
-    if (message.size() > 64 * 1024) message = message.substr(0, 64 * 1024) + "... (" + std::to_string(message.size()) + " chars)";
+    if (message.size() > 64 * 1024)
+      message = message.substr(0, 64 * 1024) + "... (" + std::to_string(message.size()) + " chars)";
     std::string record(13, '\0');
     const std::uint64_t index = k;
     const std::uint32_t length = static_cast<std::uint32_t>(message.size());
@@ -174,10 +182,10 @@ inline std::vector<CaseResult> runCases(const std::vector<FuzzCase>& cases, cons
     int status = 0;
     waitpid(pid, &status, 0);
     if (next < end) {  // the child died or hung in case `next`, which it may have left mutated
-      results[next] = hung ? CaseResult{Outcome::kHang, "no result after " + std::to_string(timeout_s) + " s"}
-                           : CaseResult{Outcome::kSignal, WIFSIGNALED(status)
-                                                              ? "signal " + std::to_string(WTERMSIG(status))
-                                                              : "child ended without a result"};
+      results[next] =
+          hung ? CaseResult{Outcome::kHang, "no result after " + std::to_string(timeout_s) + " s"}
+               : CaseResult{Outcome::kSignal, WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
+                                                                  : "child ended without a result"};
       detail::putFile(cases[next].path, cases[next].original);
       ++next;
     }
@@ -225,17 +233,17 @@ inline std::string checkStream(io::Reader& reader, bool check_camera_intrinsics)
 }
 
 struct FuzzFile {
-  std::string rel;          // relative to the fixture root
+  std::string rel;  // relative to the fixture root
   bool binary = false;
-  std::size_t record = 1;   // record size of a binary file [bytes]
+  std::size_t record = 1;  // record size of a binary file [bytes]
 };
 
 // A hand-made mutation, tried before the random ones, with what its IoError must (not) say.
 struct ExtraCase {
   std::string file;  // relative to the fixture root
   Mutation mutation;
-  std::string must_name = "";      // the IoError message must contain this
-  std::string must_not_say = "";   // ... and not this (e.g. "missing" for a key that is present but malformed)
+  std::string must_name = "";     // the IoError message must contain this
+  std::string must_not_say = "";  // ... and not this (e.g. "missing" for a key that is present but malformed)
 };
 
 struct ReaderTarget {
@@ -256,8 +264,8 @@ inline std::pair<std::size_t, Mutation> caseMutation(const ReaderTarget& t, cons
   return {f, file.binary ? mutateBinary(originals[f], rng, file.record) : mutateText(originals[f], rng)};
 }
 
-// What groups failures into one report line: the message without the fixture's path, digits collapsed, so that
-// one bug seen on many lines or values is reported once per file and kind.
+// What groups failures into one report line: the message without the fixture's path, digits collapsed and cut
+// before any quoted value, so that one bug seen on many lines or values is reported once per file and kind.
 inline std::string failureClass(const std::string& message, const std::string& root) {
   std::string m = message.substr(0, 200);
   if (m.rfind(root, 0) == 0) m = m.substr(root.size());
@@ -269,7 +277,7 @@ inline std::string failureClass(const std::string& message, const std::string& r
       out += c;
     }
   }
-  return out.substr(0, 60);
+  return out.substr(0, std::min<std::size_t>(60, out.find('\'')));  // without the quoted value
 }
 
 // Runs `cases` random cases (fewer when the fixture's first batch shows they would take more than `budget_s`) plus
@@ -320,9 +328,9 @@ inline void runCampaign(const ReaderTarget& t, std::size_t cases, double budget_
       runCases(std::vector<FuzzCase>(list.begin(), list.begin() + static_cast<std::ptrdiff_t>(probe)), readRoot);
   const double per_case = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / probe;
   const std::size_t fit = std::min(list.size(), probe + static_cast<std::size_t>(budget_s / std::max(per_case, 1e-6)));
-  const std::vector<CaseResult> rest =
-      runCases(std::vector<FuzzCase>(list.begin() + static_cast<std::ptrdiff_t>(probe),
-                                     list.begin() + static_cast<std::ptrdiff_t>(fit)), readRoot);
+  const std::vector<CaseResult> rest = runCases(std::vector<FuzzCase>(list.begin() + static_cast<std::ptrdiff_t>(probe),
+                                                                      list.begin() + static_cast<std::ptrdiff_t>(fit)),
+                                                readRoot);
   results.insert(results.end(), rest.begin(), rest.end());
   std::map<std::string, std::string> failures;  // distinct (why + message) -> the first case showing it
   std::map<Outcome, std::size_t> counts;
@@ -332,10 +340,14 @@ inline void runCampaign(const ReaderTarget& t, std::size_t cases, double budget_
     ++counts[r.outcome];
     std::string why;
     if (r.outcome == Outcome::kIoError) {
-      if (r.message.find(root.string()) == std::string::npos) why = "IoError names no file of the input";
-      else if (r.message.find('\n') != std::string::npos) why = "IoError message spans several lines";
-      else if (r.message.size() > kMaxMessageChars) why = "IoError message of " + std::to_string(r.message.size()) + " chars";
-      else if (extra && r.message.find(extra->must_name) == std::string::npos) why = "IoError does not say " + extra->must_name;
+      if (r.message.find(root.string()) == std::string::npos)
+        why = "IoError names no file of the input";
+      else if (r.message.find('\n') != std::string::npos)
+        why = "IoError message spans several lines";
+      else if (r.message.size() > kMaxMessageChars)
+        why = "IoError message of " + std::to_string(r.message.size()) + " chars";
+      else if (extra && r.message.find(extra->must_name) == std::string::npos)
+        why = "IoError does not say " + extra->must_name;
       else if (extra && !extra->must_not_say.empty() && r.message.find(extra->must_not_say) != std::string::npos)
         why = "IoError says '" + extra->must_not_say + "'";
     } else if (r.outcome != Outcome::kOk) {
@@ -347,9 +359,10 @@ inline void runCampaign(const ReaderTarget& t, std::size_t cases, double budget_
     if (!failures.count(key)) failures[key] = t.name + " " + labels[i] + " -> " + why + ": " + shown;
   }
   std::cout << "[fuzz] " << t.name << ": " << results.size() - t.extra.size() << " of " << cases << " cases + "
-            << t.extra.size() << " extra in " << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()
-            << " s; ok " << counts[Outcome::kOk] << ", IoError " << counts[Outcome::kIoError] << ", "
-            << failures.size() << " distinct failures\n";
+            << t.extra.size() << " extra in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() << " s; ok "
+            << counts[Outcome::kOk] << ", IoError " << counts[Outcome::kIoError] << ", " << failures.size()
+            << " distinct failures\n";
   std::string report;
   for (const auto& [key, line] : failures) report += "  " + line + "\n";
   EXPECT_TRUE(failures.empty()) << t.name << ": the reader broke its contract:\n" << report;

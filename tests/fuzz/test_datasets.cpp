@@ -36,10 +36,16 @@ TEST(FuzzSim, MutatedSimulatorFoldersReadCleanlyOrFailWithOneIoErrorNamingTheFil
   ReaderTarget t;
   t.name = "sim";
   t.write_fixture = [](const fs::path& root) { writeSimDataset(root / "ds"); };
-  t.files = {{"ds/calibration.yaml"},      {"ds/calibration.yaml"},     {"ds/imu.csv"},
-             {"ds/lidar/timestamps.csv"},  {"ds/camera/timestamps.csv"}, {"ds/groundtruth.txt"},
-             {"ds/scenario.json"},         {"ds/lidar/000001.bin", true, io::kSimPointBytes},
-             {"ds/lidar/000003.bin", true, io::kSimPointBytes}, {"ds/camera/000001.png", true, 1}};
+  t.files = {{"ds/calibration.yaml"},
+             {"ds/calibration.yaml"},
+             {"ds/imu.csv"},
+             {"ds/lidar/timestamps.csv"},
+             {"ds/camera/timestamps.csv"},
+             {"ds/groundtruth.txt"},
+             {"ds/scenario.json"},
+             {"ds/lidar/000001.bin", true, io::kSimPointBytes},
+             {"ds/lidar/000003.bin", true, io::kSimPointBytes},
+             {"ds/camera/000001.png", true, 1}};
   t.read = [](const fs::path& root) { return readDataset(root / "ds", "sim"); };
   runCampaign(t, 400);
 }

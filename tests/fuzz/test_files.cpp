@@ -35,7 +35,8 @@ TEST(FuzzTrajectories, MutatedTumKittiAndEurocFilesReadCleanlyOrFailNamingTheFil
   t.read = [](const fs::path& root) {
     const std::string wrong = checkTrajectory(io::readTum((root / "traj.tum").string()));
     if (!wrong.empty()) return "TUM: " + wrong;
-    const std::string k = checkTrajectory(io::readKitti((root / "traj_kitti.txt").string(), (root / "times.txt").string()));
+    const std::string k =
+        checkTrajectory(io::readKitti((root / "traj_kitti.txt").string(), (root / "times.txt").string()));
     if (!k.empty()) return "KITTI: " + k;
     const std::string e = checkTrajectory(io::readEurocCsv((root / "traj_euroc.csv").string()));
     return e.empty() ? e : "EuRoC: " + e;

@@ -32,7 +32,8 @@ TEST(FuzzHarness, ReportsEachCrashHangForeignExceptionAndWrongResultAgainstItsCa
   ASSERT_EQ(r.size(), cases.size());
   const std::vector<Outcome> expected = {Outcome::kOk,   Outcome::kIoError,        Outcome::kSignal, Outcome::kOk,
                                          Outcome::kHang, Outcome::kOtherException, Outcome::kWrong,  Outcome::kOk};
-  for (std::size_t i = 0; i < r.size(); ++i) EXPECT_EQ(r[i].outcome, expected[i]) << "case " << i << ": " << r[i].message;
+  for (std::size_t i = 0; i < r.size(); ++i)
+    EXPECT_EQ(r[i].outcome, expected[i]) << "case " << i << ": " << r[i].message;
   EXPECT_EQ(readText(path), "ok") << "the file of a case that crashed is put back";
 }
 

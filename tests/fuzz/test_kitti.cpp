@@ -23,8 +23,12 @@ TEST(FuzzKittiOdometry, MutatedSequencesReadCleanlyOrFailWithOneIoErrorNamingThe
   ReaderTarget t;
   t.name = "kitti odometry";
   t.write_fixture = [](const fs::path& root) { writeKittiSequence(root / "00", 4, 6, 24); };
-  t.files = {{"00/times.txt"}, {"00/calib.txt"}, {"00/calib.txt"}, {"00/poses.txt"},
-             {"00/velodyne/000000.bin", true, 16}, {"00/velodyne/000002.bin", true, 16},
+  t.files = {{"00/times.txt"},
+             {"00/calib.txt"},
+             {"00/calib.txt"},
+             {"00/poses.txt"},
+             {"00/velodyne/000000.bin", true, 16},
+             {"00/velodyne/000002.bin", true, 16},
              {"00/image_2/000001.png", true, 1}};
   t.read = [](const fs::path& root) { return readDataset(root / "00", "kitti"); };
   // Item 9 of issue 14: one NaN point (README: "NaN/inf points are dropped").
