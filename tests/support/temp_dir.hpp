@@ -14,6 +14,7 @@ class TempDir {
   TempDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
     std::string name = info ? std::string(info->test_suite_name()) + "_" + info->name() : "drover";
+    for (char& c : name) c = c == '/' ? '_' : c;  // parameterised tests: "Prefix/Suite", "Test/0"
     path_ = std::filesystem::temp_directory_path() / ("drover_" + name + "_" + std::to_string(std::random_device{}()));
     std::filesystem::create_directories(path_);
   }
