@@ -104,7 +104,9 @@ Json commonJson(const char* metric, const CommonOptions& o, eval::PoseRelation r
   return j;
 }
 
+// The table on stdout, as evo prints it; -q (only errors) silences it: --json then holds the result.
 void printResult(const std::string& title, std::size_t pairs, std::size_t max_pairs, const eval::ErrorStatistics& s) {
+  if (!spdlog::should_log(spdlog::level::info)) return;
   fmt::print("{}\n\nmatched pose pairs: {} of max. {}\nvalues: {}\n\n{}", title, pairs, max_pairs, s.count,
              statisticsTable(s));
 }
@@ -130,6 +132,12 @@ void runApe(const CommonOptions& o) {
 
 void runRpe(const RpeCliOptions& c) {
   const CommonOptions& o = c.common;
+  const bool frames = !(c.delta_unit == "meters" || c.delta_unit == "m");
+  constexpr double kMaxFrames = 1e9;
+  if (frames && !(c.delta >= 1 && c.delta <= kMaxFrames && c.delta == std::floor(c.delta)))
+    throw std::invalid_argument(fmt::format(
+        "--delta: with --delta-unit frames, expected a whole number of frames in [1, {:.0f}], got {}", kMaxFrames,
+        c.delta));
   Trajectory ref, est;
   loadBoth(o, ref, est);
   eval::RpeOptions options;
@@ -137,8 +145,7 @@ void runRpe(const RpeCliOptions& c) {
   options.alignment = parseAlignment(o.align);
   options.association = associationOptions(o);
   options.delta = c.delta;
-  options.unit =
-      (c.delta_unit == "meters" || c.delta_unit == "m") ? eval::DeltaUnit::kMeters : eval::DeltaUnit::kFrames;
+  options.unit = frames ? eval::DeltaUnit::kFrames : eval::DeltaUnit::kMeters;
   options.pairs_from_reference = c.pairs_from_reference;
   const eval::RpeResult r = onFiles(o, [&] { return eval::computeRpe(ref, est, options); });
   printResult(rpeTitle(r, options), r.pairs, r.max_pairs, r.stats);
@@ -172,7 +179,7 @@ void runKitti(const CommonOptions& o) {
     throw std::invalid_argument(fmt::format("KITTI drift matches poses by index: {} has {} poses but {} has {}", o.ref,
                                             ref.size(), o.est, est.size()));
   const eval::KittiDriftResult r = onFiles(o, [&] { return eval::computeKittiDrift(posesOf(ref), posesOf(est)); });
-  fmt::print("{}", kittiTable(r));
+  if (spdlog::should_log(spdlog::level::info)) fmt::print("{}", kittiTable(r));
   if (!o.json.empty()) {
     Json j = kittiJson(r);
     j["reference"] = o.ref;

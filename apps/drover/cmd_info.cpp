@@ -232,7 +232,7 @@ void runInfo(const InfoOptions& o) {
     throw std::runtime_error(o.dataset + ": the dataset has no ground truth to export to " + o.export_gt);
   const Summary summary = streamDataset(*reader);
   const Json j = summaryJson(o, *reader, summary);
-  fmt::print("{}", summaryText(j, summary, *reader));
+  if (spdlog::should_log(spdlog::level::info)) fmt::print("{}", summaryText(j, summary, *reader));  // -q: --json only
   if (!o.json.empty()) io::writeFileAtomically(o.json, j.dump(2) + "\n");
   if (!o.export_gt.empty()) io::writeTum(o.export_gt, reader->groundTruth().poses);
 }

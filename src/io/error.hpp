@@ -7,10 +7,27 @@
 
 namespace drover::io {
 
+// `text` as one bounded line: control characters shown as '?' and, past `max` characters, cut with its length
+// added. Every error message goes through it (IoError, and main() for any other exception), so no input -- a
+// 200,000-digit token, a file name of a megabyte, a value with line breaks -- can make an error longer than a line.
+inline std::string boundedText(std::string_view text, std::size_t max) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    out += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
+  }
+  if (text.size() > max) out += "... (" + std::to_string(text.size()) + " characters)";
+  return out;
+}
+
 class IoError : public std::runtime_error {
  public:
+  static constexpr std::size_t kMaxPart = 300;  // [characters] of the file, the record and the reason each
+
   IoError(std::string file, std::string record, const std::string& what)
-      : std::runtime_error(file + (record.empty() ? "" : " (" + record + ")") + ": " + what),
+      : std::runtime_error(boundedText(file, kMaxPart) +
+                           (record.empty() ? "" : " (" + boundedText(record, kMaxPart) + ")") + ": " +
+                           boundedText(what, kMaxPart)),
         file_(std::move(file)),
         record_(std::move(record)) {}
   const std::string& file() const { return file_; }

@@ -149,6 +149,9 @@ std::vector<ImageEntry> readImageCsv(const std::string& csv, const fs::path& ima
     requireColumns(fields, 2, csv, record);
     const Time t = parseInt64(fields[0], csv, record);
     if (fields[1].empty()) fail(csv, record, "empty image file name");
+    constexpr std::size_t kMaxName = 255;  // [bytes] NAME_MAX of Linux file systems
+    if (fields[1].size() > kMaxName || fields[1].find('/') != std::string_view::npos)
+      fail(csv, record, "image file name " + echo(fields[1]) + " is not a plain file name of at most 255 characters");
     if (!entries.empty() && t <= entries.back().t) {
       dropped.push_back(staleStampNotice(entries.back().t, t, csv, record));
       continue;
@@ -161,7 +164,8 @@ std::vector<ImageEntry> readImageCsv(const std::string& csv, const fs::path& ima
 // ---- images ---------------------------------------------------------------------------------------------------
 
 Image decodeImage(const ImageEntry& entry, const CameraIntrinsics& cam) {
-  if (!fs::exists(entry.path)) fail(entry.path, "listed in " + entry.record, "image file not found");
+  std::error_code ec;  // the error_code form: a name the file system refuses is "not found", never a throw
+  if (!fs::exists(entry.path, ec)) fail(entry.path, "listed in " + entry.record, "image file not found");
   cv::Mat mat = decodeImageFile(entry.path);
   if (mat.depth() != CV_8U) fail(entry.path, "", "expected an 8-bit image");
   if (mat.channels() == 4) cv::cvtColor(mat, mat, cv::COLOR_BGRA2BGR);
