@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   } catch (const drover::cli::ExitCode& e) {
     return e.code;
   } catch (const std::exception& e) {
-    spdlog::error("{}", drover::io::boundedText(e.what(), 1000));  // any message stays one line of bounded length
+    spdlog::error("{}", drover::io::boundedText(e.what(), 2000));  // any message stays one line of bounded length
     return 2;
   }
   return 0;

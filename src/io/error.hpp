@@ -22,12 +22,13 @@ inline std::string boundedText(std::string_view text, std::size_t max) {
 
 class IoError : public std::runtime_error {
  public:
-  static constexpr std::size_t kMaxPart = 300;  // [characters] of the file, the record and the reason each
+  // [characters] of each part: a bag's topic list can fill a few hundred legitimately; past these, a part is cut.
+  static constexpr std::size_t kMaxFile = 400, kMaxRecord = 100, kMaxWhat = 1400;
 
   IoError(std::string file, std::string record, const std::string& what)
-      : std::runtime_error(boundedText(file, kMaxPart) +
-                           (record.empty() ? "" : " (" + boundedText(record, kMaxPart) + ")") + ": " +
-                           boundedText(what, kMaxPart)),
+      : std::runtime_error(boundedText(file, kMaxFile) +
+                           (record.empty() ? "" : " (" + boundedText(record, kMaxRecord) + ")") + ": " +
+                           boundedText(what, kMaxWhat)),
         file_(std::move(file)),
         record_(std::move(record)) {}
   const std::string& file() const { return file_; }

@@ -88,7 +88,7 @@ inline std::string contractBreach(const CliCase& c, const CliRun& r, const std::
   if (errors.size() != 1) return std::to_string(errors.size()) + " [error] lines instead of one";
   const std::string names = expand(c.names, vars);
   if (!names.empty() && errors[0].find(names) == std::string::npos) return "the [error] line does not name " + names;
-  if (errors[0].size() > 1000) return "an [error] line of " + std::to_string(errors[0].size()) + " chars";
+  if (errors[0].size() > 2000) return "an [error] line of " + std::to_string(errors[0].size()) + " chars";
   for (const std::string& o : c.outputs) {
     const fs::path p = expand(o, vars);
     if (fs::exists(p)) return "failed but left " + p.string() + ", which looks complete";

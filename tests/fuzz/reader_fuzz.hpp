@@ -40,7 +40,7 @@ namespace drover::test::fuzz {
 namespace fs = std::filesystem;
 
 constexpr double kCaseTimeout = 10.0;              // [s] a reader slower than this on a tiny fixture hangs
-constexpr std::size_t kMaxMessageChars = 1000;     // an error line is short
+constexpr std::size_t kMaxMessageChars = 2000;     // an error line is bounded (io::IoError's parts)
 constexpr rlim_t kChildAddressSpace = 2ull << 30;  // [bytes]
 
 enum class Outcome { kOk, kIoError, kWrong, kOtherException, kSignal, kHang };
