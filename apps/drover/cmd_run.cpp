@@ -65,11 +65,8 @@ io::DatasetOptions datasetOptions(const RunOptions& o) {
   return d;
 }
 
+// --start and --duration were checked when the command line was read (addSeconds).
 void checkOptions(const RunOptions& o) {
-  if (!std::isfinite(o.start) || o.start < 0)
-    throw std::invalid_argument(fmt::format("--start must be >= 0 s, got {}", o.start));
-  if (!std::isfinite(o.duration) || o.duration < 0)
-    throw std::invalid_argument(fmt::format("--duration must be >= 0 s, got {}", o.duration));
   if (!fs::exists(o.dataset)) throw std::invalid_argument("dataset " + o.dataset + " not found");
   io::StagedFolder::check(o.out, runFolderRules());  // before any work: a foreign or unusable --out costs nothing
 }

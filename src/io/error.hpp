@@ -22,8 +22,8 @@ inline std::string boundedText(std::string_view text, std::size_t max) {
 
 class IoError : public std::runtime_error {
  public:
-  // [characters] of each part: a bag's topic list can fill a few hundred legitimately; past these, a part is cut.
-  static constexpr std::size_t kMaxFile = 400, kMaxRecord = 100, kMaxWhat = 1400;
+  // [characters] of each part (under 2000 in all): a record can name a file, a bag's topic list fills hundreds.
+  static constexpr std::size_t kMaxFile = 400, kMaxRecord = 400, kMaxWhat = 1100;
 
   IoError(std::string file, std::string record, const std::string& what)
       : std::runtime_error(boundedText(file, kMaxFile) +
