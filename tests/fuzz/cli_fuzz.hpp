@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "support/cli.hpp"
+
 namespace drover::test::fuzz {
 namespace fs = std::filesystem;
 
@@ -35,22 +37,12 @@ struct CliCase {
   int timeout_s = 30;
 };
 
-struct CliRun {
-  int exit_code = -1;  // 124: timed out; >= 128 or -1: killed by a signal
-  std::string output;
-};
+// exit_code 124: timed out; >= 128 or -1: killed by a signal.
+using CliRun = CliResult;
 
 inline CliRun runCli(const std::string& args, int timeout_s) {
-  CliRun r;
-  const std::string cmd = "ulimit -v 4194304; exec timeout -k 2 " + std::to_string(timeout_s) + " " +
-                          std::string(DROVER_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return runShell("ulimit -v 4194304; exec timeout -k 2 " + std::to_string(timeout_s) + " " +
+                  std::string(DROVER_BINARY) + " " + args + " 2>&1");
 }
 
 inline std::string expand(std::string s, const std::map<std::string, std::string>& vars) {

@@ -17,16 +17,21 @@ struct CliResult {
   std::string output;  // stdout and stderr together
 };
 
-inline CliResult runDrover(const std::string& args) {
+// Runs a shell command line (stderr already redirected by the caller): its exit code (-1 when a signal ended the
+// shell) and everything it printed.
+inline CliResult runShell(const std::string& command) {
   CliResult r;
-  const std::string cmd = std::string(DROVER_BINARY) + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
+  FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return r;
   std::array<char, 4096> buf{};
   while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
   const int status = pclose(pipe);
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+inline CliResult runDrover(const std::string& args) {
+  return runShell(std::string(DROVER_BINARY) + " " + args + " 2>&1");
 }
 
 // A JSON file the command wrote (a failed expectation when it cannot be opened).

@@ -23,15 +23,7 @@ namespace drover::test {
 
 // runDrover from CWD, with optional `NAME=value ...` environment assignments in front.
 inline CliResult runDroverIn(const std::filesystem::path& cwd, const std::string& args, const std::string& env = "") {
-  CliResult r;
-  const std::string cmd = "cd '" + cwd.string() + "' && " + env + " " + DROVER_BINARY + " " + args + " 2>&1";
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), buf.size(), pipe)) r.output += buf.data();
-  const int status = pclose(pipe);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return runShell("cd '" + cwd.string() + "' && " + env + " " + DROVER_BINARY + " " + args + " 2>&1");
 }
 
 inline std::string readText(const std::filesystem::path& p) {
