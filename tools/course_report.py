@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Accuracy of a `drover run` on a simulated course, overall and per labelled segment.
 
-Usage: course_report.py DATASET_DIR RUN_DIR [--json OUT.json]
+Usage: course_report.py DATASET_DIR RUN_DIR [--json OUT.json] [--trajectory trajectory_vis.tum]
 
 DATASET_DIR is a `drover sim` folder (groundtruth.txt: T_world_imu, TUM; scenario.json: path length and labelled
 segments); RUN_DIR holds the run's trajectory.tum (T_world_imu, one pose per sweep). The estimate is put in the
-ground truth's frame by its first pose (no fitting, so drift shows in full). Figures:
+ground truth's frame by its first pose (no fitting, so drift shows in full). Estimate stamps that are not ground-truth
+stamps (camera frames, an estimated time offset) get the ground truth interpolated (translation linearly, rotation of
+the nearer sample) when within one ground-truth step. Figures:
   end_error_m        |p_est(end) - p_gt(end)| after that first-pose alignment
   drift_percent      end_error_m / ground-truth path length * 100
   start_end_m        |p_est(end) - p_est(start)| (closed courses end where they start)
@@ -53,23 +55,42 @@ def path_length(poses):
     return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1))) if len(p) > 1 else 0.0
 
 
+def gt_at(gt_times, gt, t):
+    """Ground-truth pose at t [ns]: exact, or interpolated between two samples at most 10 ms apart."""
+    k = int(np.searchsorted(gt_times, t))
+    if k < len(gt_times) and gt_times[k] == t:
+        return gt[k]
+    if k == 0 or k == len(gt_times) or gt_times[k] - gt_times[k - 1] > 10_000_000:
+        return None
+    a, b = gt[k - 1], gt[k]
+    s = (t - gt_times[k - 1]) / (gt_times[k] - gt_times[k - 1])
+    T = (a if s < 0.5 else b).copy()
+    T[:3, 3] = (1 - s) * a[:3, 3] + s * b[:3, 3]
+    return T
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("dataset")
     ap.add_argument("run")
     ap.add_argument("--json")
+    ap.add_argument("--trajectory", default="trajectory.tum", help="file in RUN_DIR (trajectory_vis.tum: the VIS)")
     a = ap.parse_args()
     gt_t, gt = load_tum(f"{a.dataset}/groundtruth.txt")
-    est_t, est = load_tum(f"{a.run}/trajectory.tum")
+    est_t, est = load_tum(f"{a.run}/{a.trajectory}")
     with open(f"{a.dataset}/scenario.json") as f:
         scenario = json.load(f)
-    index = {t: i for i, t in enumerate(gt_t)}
-    pairs = [(i, index[t]) for i, t in enumerate(est_t) if t in index]
+    gt_times = np.array(gt_t, dtype=np.int64)
+    pairs, gt_m = [], []
+    for i, t in enumerate(est_t):
+        G = gt_at(gt_times, gt, t)
+        if G is not None:
+            pairs.append(i)
+            gt_m.append(G)
     if len(pairs) < 2:
         sys.exit(f"error: fewer than 2 estimate poses match ground-truth stamps in {a.run}")
-    gt_m = [gt[j] for _, j in pairs]
-    est_m = [est[i] for i, _ in pairs]
-    times = np.array([est_t[i] for i, _ in pairs])
+    est_m = [est[i] for i in pairs]
+    times = np.array([est_t[i] for i in pairs])
     align = gt_m[0] @ np.linalg.inv(est_m[0])
     est_a = [align @ T for T in est_m]
     errors = np.array([np.linalg.norm(E[:3, 3] - G[:3, 3]) for E, G in zip(est_a, gt_m)])

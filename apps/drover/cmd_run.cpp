@@ -15,6 +15,7 @@
 #include "apps/drover/commands.hpp"
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
+#include "apps/drover/run_vis.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "io/odometry/odometry_config_io.hpp"
@@ -27,7 +28,7 @@ using Clock = std::chrono::steady_clock;
 
 struct RunOptions {
   std::string dataset, format, config, out;
-  bool no_imu = false, no_camera = false, no_loop = false, quiet = false;
+  bool no_imu = false, no_camera = false, no_lidar = false, no_loop = false, quiet = false;
   double start = 0, duration = 0;  // [s] from the first measurement; duration 0 = to the end
   std::size_t max_frames = 0;      // KITTI odometry: first N frames only
 };
@@ -59,8 +60,9 @@ class RunProgress {
 io::DatasetOptions datasetOptions(const RunOptions& o) {
   io::DatasetOptions d = o.config.empty() ? io::DatasetOptions{} : io::loadDatasetOptions(o.config);
   if (o.no_imu) d.load_imu = false;
-  // The LIS does not use images yet; they are not decoded unless the VIS needs them.
-  d.load_images = false;
+  if (o.no_lidar) d.load_lidar = false;
+  // Images are decoded only for the VIS, which is visual-inertial: not without an IMU (KITTI odometry has none).
+  if (o.no_camera || o.no_imu || o.format == "kitti") d.load_images = false;
   d.kitti_max_frames = o.max_frames;
   return d;
 }
@@ -68,6 +70,10 @@ io::DatasetOptions datasetOptions(const RunOptions& o) {
 // --start and --duration were checked when the command line was read (addSeconds).
 void checkOptions(const RunOptions& o) {
   if (!fs::exists(o.dataset)) throw std::invalid_argument("dataset " + o.dataset + " not found");
+  if (o.no_lidar && o.no_camera)
+    throw std::invalid_argument("--no-lidar with --no-camera leaves nothing to run: drover run needs a lidar or a camera");
+  if (o.no_lidar && o.no_imu)
+    throw std::invalid_argument("--no-lidar with --no-imu: the VIS is visual-inertial and needs the IMU");
   io::StagedFolder::check(o.out, runFolderRules());  // before any work: a foreign or unusable --out costs nothing
 }
 
@@ -106,11 +112,20 @@ void showNotices(const pipeline::LidarOdometry& odometry, const RunOptions& o, R
 }
 
 // A run in which no sweep produced a pose is a failure with its reason, not an empty success.
-void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o) {
+void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o, const RunVis* vis) {
   const std::string window = o.start > 0 || o.duration > 0 ? " in the --start/--duration window" : "";
+  if (o.no_lidar) {
+    if (vis == nullptr || vis->framesIn() == 0)
+      throw std::invalid_argument("dataset " + o.dataset + " has no camera frames" + window +
+                                  ": drover run --no-lidar runs the VIS, which needs a camera and an IMU");
+    if (vis->trajectory().empty())
+      throw std::invalid_argument(fmt::format("{}: the VIS did not initialise in {} camera frames{}: {}", o.dataset,
+                                              vis->framesIn(), window, vis->report().value("not_initialized_because", "")));
+    return;
+  }
   if (s.scans_in == 0)
     throw std::invalid_argument("dataset " + o.dataset + " has no lidar scans" + window +
-                                ": drover run needs a lidar (the visual-inertial subsystem is not built yet)");
+                                ": drover run needs a lidar, or --no-lidar to run the VIS alone (camera + IMU)");
   if (s.scans_processed == 0)
     throw std::invalid_argument(fmt::format(
         "{}: no sweep produced a pose{}: of {} sweeps, {} had too few valid points (odometry.min_points) and {} a "
@@ -143,6 +158,19 @@ void runOdometry(const RunOptions& o) {
   };
   std::size_t scans_read = 0;  // lidar scans the reader gave, before --start included
   StopOnSignal stop;           // SIGINT/SIGTERM: stop reading and write what was processed
+  std::unique_ptr<RunVis> vis;  // made at the first camera frame (a dataset without images runs the LIS alone)
+  std::optional<ImuSample> last_imu;
+  const auto visFor = [&]() -> RunVis& {
+    if (!vis) {
+      vis = std::make_unique<RunVis>(o.config, reader->calibration(), config.preintegration);
+      if (last_imu) vis->onImu(*last_imu);  // the first frame's interval starts at the sample before it
+      if (!o.no_lidar)
+        odometry.setSweepListener([&vis](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
+          vis->onSweep(t, T, p);
+        });
+    }
+    return *vis;
+  };
   while (std::optional<Measurement> m = stop.requested() ? std::nullopt : reader->next()) {
     showReaderDrops();
     const Time t = measurementTime(*m);
@@ -156,7 +184,19 @@ void runOdometry(const RunOptions& o) {
     }
     if (const auto* scan = std::get_if<LidarScan>(&*m))
       record.scan_times.push_back(scan->t + reader->calibration().lidar_time_offset);
-    keep(odometry.process(*m), record);
+    if (const auto* frame = std::get_if<CameraFrame>(&*m)) {
+      visFor().onFrame(*frame, o.no_lidar ? nullptr : &odometry);
+      continue;
+    }
+    if (const auto* sample = std::get_if<ImuSample>(&*m)) {
+      last_imu = *sample;
+      if (vis) vis->onImu(*sample);
+    }
+    if (o.no_lidar) continue;
+    std::vector<pipeline::ScanOutcome> outcomes = odometry.process(*m);
+    if (vis)
+      for (const pipeline::ScanOutcome& s : outcomes) vis->onLisState(s);
+    keep(std::move(outcomes), record);
     showNotices(odometry, o, record);
     progress.update(record.scans.size(), since - o.start);
   }
@@ -164,16 +204,17 @@ void runOdometry(const RunOptions& o) {
   if (o.max_frames > 0 && o.format == "kitti" && scans_read >= o.max_frames) record.end = "--max-frames reached";
   const int interrupted_by = stop.signal();  // a signal after the reading is done changes nothing
   if (interrupted_by) record.end = "interrupted by " + signalName(interrupted_by);
-  keep(odometry.finish(), record);
+  if (!o.no_lidar) keep(odometry.finish(), record);
   showNotices(odometry, o, record);
-  checkSomethingWasDone(odometry.stats(), o);
+  checkSomethingWasDone(odometry.stats(), o, vis.get());
   record.wall_s = progress.wallSeconds();
   record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
   // Only now, and as OUT.partial: a run that fails on its data leaves no folder behind, one killed while writing
   // leaves an earlier run in OUT whole.
   io::StagedFolder folder(o.out, runFolderRules());
   RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string()};
-  writeRunFolder(context, odometry, record);
+  if (o.no_lidar) writeVisRunFolder(context, *vis, record);
+  else writeRunFolder(context, odometry, record, vis.get());
   folder.publish();
   if (!interrupted_by) return;
   spdlog::warn("{}: wrote the {} sweeps processed before it to {}", record.end, record.scans.size(), o.out);
@@ -195,7 +236,8 @@ void registerRun(CLI::App& app) {
                                   "earlier run folder)")->required();
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");
-  cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera (the LIS does not use it yet either way)");
+  cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera: the LIS alone (no VIS)");
+  cmd->add_flag("--no-lidar", o->no_lidar, "Ignore the lidar: the VIS alone (camera + IMU, visual-inertial initialisation)");
   addSeconds(cmd, "--start", o->start, atLeast(0, "s"), "Skip the first S seconds of the dataset");
   addSeconds(cmd, "--duration", o->duration, atLeast(0, "s"), "Process S seconds after --start (0 = to the end)");
   addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000,

@@ -9,6 +9,7 @@
 
 #include "apps/drover/eval_report.hpp"
 #include "apps/drover/loop_report.hpp"
+#include "apps/drover/run_vis.hpp"
 #include "eval/ape.hpp"
 #include "geometry/trajectory_fill.hpp"
 #include "io/cloud_io.hpp"
@@ -207,9 +208,60 @@ Json imuRateJson(const RunContext& c, const Trajectory& est) {
   return j;
 }
 
+double pathLength(const Trajectory& poses) {  // [m]
+  double length = 0;
+  for (std::size_t k = 1; k < poses.size(); ++k)
+    length += (poses[k].T_world_body.translation() - poses[k - 1].T_world_body.translation()).norm();
+  return length;
+}
+
+// The VIS's T_world_imu per camera frame -> trajectory_vis.tum in trajectory.tum's body frame; returns report.json's
+// "vis" section with the VIS's own translation APE (SE(3)-aligned) when there is ground truth, printed as evo does.
+Json writeVisTrajectory(const RunContext& c, const RunVis& vis) {
+  Json j = vis.report();
+  const Trajectory est = imuRateInBodyFrame(vis.trajectory(), c);
+  if (est.empty()) return j;
+  io::writeTum(inRun(c, "trajectory_vis.tum"), est);
+  if (c.ground_truth.poses.empty() || est.size() < 3) return j;
+  try {
+    const eval::ApeResult a = eval::computeApe(c.ground_truth.poses, est, se3ApeOptions());
+    if (spdlog::should_log(spdlog::level::info)) fmt::print("VIS {}\n\n{}\n", apeTitle(a), statisticsTable(a.stats));
+    j["ape"] = statisticsJson(a.stats);
+    const double length = pathLength(c.ground_truth.poses);
+    if (length > 0) j["ape"]["rmse_percent_of_path"] = 100.0 * a.stats.rmse / length;
+  } catch (const std::invalid_argument& e) {
+    j["ape"] = {{"error", e.what()}};
+  }
+  return j;
+}
+
 }  // namespace
 
-void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r) {
+void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& r) {
+  const Trajectory est = imuRateInBodyFrame(vis.trajectory(), c);
+  io::writeTum(inRun(c, "trajectory.tum"), est);
+  Json report;
+  report["dataset"] = c.dataset;
+  report["format"] = c.format;
+  report["config"] = c.config;
+  report["mode"] = "camera+imu";
+  report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};
+  report["body_frame"] = c.ground_truth.body_frame.empty() ? "imu" : c.ground_truth.body_frame;
+  report["wall_s"] = r.wall_s;
+  const double data_s = est.size() > 1 ? toSeconds(est.back().t - est.front().t) : 0.0;
+  report["data_s"] = data_s;
+  report["real_time_factor"] = r.wall_s > 0 ? data_s / r.wall_s : 0.0;
+  report["counts"] = {{"measurements_dropped", r.measurements_dropped}};
+  report["ape"] = evaluate(c, est);
+  report["vis"] = writeVisTrajectory(c, vis);
+  io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
+  spdlog::info("VIS: {} of {} camera frames estimated, {} resets, in {:.1f} s: {:.1f}x real time; results in {}",
+               est.size(), vis.framesIn(), report["vis"]["resets"].get<std::size_t>(), r.wall_s,
+               r.wall_s > 0 ? data_s / r.wall_s : 0.0, c.out);
+}
+
+void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r,
+                    const RunVis* vis) {
   const Trajectory est = inBodyFrame(odometry.trajectory(), c);
   if (!est.empty()) {
     io::writeTum(inRun(c, "trajectory.tum"), est);
@@ -241,6 +293,8 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["loops"] = loopsJson(c, odometry);
   if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
   if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
+  if (vis != nullptr) report["vis"] = writeVisTrajectory(c, *vis);
+  report["mode"] = std::string(report["mode"]) + (vis != nullptr && !vis->trajectory().empty() ? "+camera" : "");
   report["scans"] = scansJson(r);
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",

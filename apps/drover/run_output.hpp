@@ -7,6 +7,8 @@
 //   keyframes.tum         the keyframes' poses, same frame as trajectory.tum
 //   trajectory_imu_rate.tum  with the IMU: the IMU-rate odometry (the fused state propagated to each IMU sample as
 //                         it arrives), same frame as trajectory.tum
+//   trajectory_vis.tum    with a camera and an IMU: the VIS estimate at every camera frame after its initialisation,
+//                         same body frame as trajectory.tum (with --no-lidar trajectory.tum is this trajectory)
 //   map.pcd, map.ply      the keyframes' clouds in the world frame (binary)
 //   report.json           how the run ended, counts, per-stage timings, degenerate sweeps, resets, and the APE when there is ground truth
 //   ape.json, ape.png     APE (translation, SE(3)-aligned) against the ground truth, when there is one
@@ -15,6 +17,10 @@
 
 #include "io/reader.hpp"
 #include "pipeline/lidar_odometry.hpp"
+
+namespace drover::cli {
+class RunVis;
+}
 
 namespace drover::cli {
 
@@ -41,6 +47,10 @@ struct RunRecord {
 
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be
 // written.
-void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, const RunRecord& record);
+// vis: the VIS when it ran beside the LIS (nullptr otherwise).
+void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, const RunRecord& record,
+                    const RunVis* vis);
+// --no-lidar: the VIS alone (trajectory.tum, trajectory_vis.tum, report.json, ape.json/png).
+void writeVisRunFolder(const RunContext& context, const RunVis& vis, const RunRecord& record);
 
 }  // namespace drover::cli

@@ -51,6 +51,7 @@ struct LidarOdometry::Impl {
   geometry::Matrix6d degenerate_since_kf = geometry::Matrix6d::Zero();  // sum of d d^T since the last keyframe
   int degenerate_run = 0;               // consecutive degenerate sweeps
   std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
+  SweepListener sweep_listener;         // the VIS's lidar depth (setSweepListener)
 
   Impl(const OdometryConfig& c, const Calibration& calib)
       : config(c),
@@ -121,6 +122,8 @@ Trajectory LidarOdometry::keyframeTrajectory() const {
     out.push_back({impl_->map.keyframe(i).t, impl_->map.keyframe(i).T_world_lidar});
   return out;
 }
+
+void LidarOdometry::setSweepListener(SweepListener listener) { impl_->sweep_listener = std::move(listener); }
 
 lidar::PointCloud LidarOdometry::mapCloud(float leaf) const {
   std::vector<std::size_t> all(impl_->map.size());
@@ -213,6 +216,7 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   if (out.imu_used) ++stats.imu_scans;
 
   accumulateDegeneracy(out);
+  if (sweep_listener) sweep_listener(scan.t, out.T_world_lidar, features.full);
   keyframe(features, out);
   record(out);
   ++stats.scans_processed;

@@ -8,6 +8,7 @@
 // empty scans, stamps going backwards or repeating, IMU gaps and spikes, a diverging smoother) is handled with a
 // counted warning, never a crash: see OdometryStats.
 #include <Eigen/Geometry>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -111,6 +112,12 @@ class LidarOdometry {
   const OdometryStats& stats() const;
   const OdometryConfig& config() const;
   const LoopClosure& loopClosure() const;  // loop events and statistics
+
+  // Where the VIS plugs in: called for every processed sweep with its deskewed, downsampled points in the lidar
+  // frame at the sweep's start and the estimated T_world_lidar there (the VIS's lidar depth comes from these).
+  using SweepListener = std::function<void(Time t, const Eigen::Isometry3d& T_world_lidar,
+                                           const std::vector<Eigen::Vector3f>& points_lidar)>;
+  void setSweepListener(SweepListener listener);
 
  private:
   struct Impl;

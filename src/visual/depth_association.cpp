@@ -189,6 +189,7 @@ DepthAssociationResult DepthAssociator::associate(Time t, const Eigen::Isometry3
     }
     out.status = DepthStatus::kOk;
     out.depth = depth;
+    out.spread = r_max - r_min;
     ++result.associated;
   }
   return result;

@@ -41,7 +41,8 @@ enum class DepthStatus { kOk, kNoNeighbours, kDiscontinuity, kGrazing, kOutOfRan
 
 struct FeatureDepth {
   DepthStatus status = DepthStatus::kNoNeighbours;
-  double depth = 0;  // [m] along the camera's z axis; valid when status == kOk
+  double depth = 0;   // [m] along the camera's z axis; valid when status == kOk
+  double spread = 0;  // [m] range spread of the three lidar neighbours (the VIS's depth sigma grows with it)
 };
 
 struct DepthAssociationResult {

@@ -101,6 +101,9 @@ std::vector<cv::Point2f> carry(std::vector<cv::Point2f> points, const cv::Mat& f
 
 void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
   cv::Mat mask = crowdMask(result);
+  // Detect-when-needed: a slow detector (SuperPoint) runs only when the live tracks fall below detect_below.
+  const bool enough = config_.detect_below > 0 && static_cast<int>(tracks_.size()) >= config_.detect_below;
+  if (enough && !(config_.async_detection && job_.valid())) return;
   if (!config_.async_detection || tracks_.size() == 0) {
     if (config_.async_detection && job_.valid()) job_.wait();  // the detector serves one caller at a time
     const int wanted = config_.max_features - static_cast<int>(tracks_.size());

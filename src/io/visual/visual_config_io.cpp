@@ -65,7 +65,8 @@ void bindTracker(YamlSection& s, visual::FeatureTrackerConfig& c, std::string& c
       .bind("clahe_clip", c.clahe_clip)
       .bind("clahe_tiles", c.clahe_tiles)
       .bind("dark_mean", c.dark_mean)
-      .bind("async_detection", c.async_detection);
+      .bind("async_detection", c.async_detection)
+      .bind("detect_below", c.detect_below);
 }
 
 void bindDepth(YamlSection& s, visual::DepthAssociationConfig& c) {

@@ -1,0 +1,157 @@
+#include "apps/drover/run_vis.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "io/visual/visual_config_io.hpp"
+#include "io/visual/vio_config_io.hpp"
+
+namespace drover::cli {
+namespace {
+
+using Json = nlohmann::json;
+
+// T_world_imu of the LIS's IMU-rate odometry at t: interpolated between its samples, or its newest sample when t is
+// at most 20 ms past it (the camera frame can arrive before the IMU sample after it).
+std::optional<Eigen::Isometry3d> lisPoseAt(const Trajectory& imu_rate, Time t) {
+  if (imu_rate.empty() || t < imu_rate.front().t) return std::nullopt;
+  auto it = std::lower_bound(imu_rate.begin(), imu_rate.end(), t,
+                             [](const StampedPose& p, Time x) { return p.t < x; });
+  if (it == imu_rate.end()) {
+    if (t - imu_rate.back().t > 20'000'000) return std::nullopt;
+    return imu_rate.back().T_world_body;
+  }
+  if (it->t == t || it == imu_rate.begin()) return it->T_world_body;
+  const StampedPose& a = *std::prev(it);
+  const StampedPose& b = *it;
+  const double s = static_cast<double>(t - a.t) / static_cast<double>(b.t - a.t);
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(a.T_world_body.rotation())
+                   .slerp(s, Eigen::Quaterniond(b.T_world_body.rotation()))
+                   .toRotationMatrix();
+  T.translation() = (1 - s) * a.T_world_body.translation() + s * b.T_world_body.translation();
+  return T;
+}
+
+constexpr std::size_t kMaxEvents = 200;  // report.json keeps the first events; the counters count them all
+
+}  // namespace
+
+RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu) {
+  io::VisualConfig visual = config_path.empty() ? io::VisualConfig{} : io::loadVisualConfig(config_path);
+  vio_config_ = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
+  vio::VisConfig c;
+  c.vio = vio_config_;
+  c.tracker = visual.tracker;
+  c.depth = visual.depth;
+  detector_name_ = visual::detectorTypeName(visual.detector.type);
+  std::shared_ptr<visual::KeypointDetector> detector = visual::makeDetector(visual.detector);
+  vo_ = std::make_unique<vio::VisualOdometry>(c, calibration, imu, std::move(detector));
+}
+
+RunVis::~RunVis() = default;
+
+void RunVis::onImu(const ImuSample& sample) { vo_->addImu(sample); }
+
+void RunVis::onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points) {
+  vo_->addSweep(t, T_world_lidar, points);
+}
+
+void RunVis::onLisState(const pipeline::ScanOutcome& outcome) {
+  if (outcome.has_imu_state) lis_state_ = outcome;
+}
+
+// The LIS's state at a camera stamp: the IMU-rate pose, a velocity from the poses 40 ms apart (first order; the
+// window's IMU factors refine it), and the biases of its newest fused sweep.
+std::optional<vio::SeedState> RunVis::seedAt(Time t, const pipeline::LidarOdometry& lis) const {
+  if (!lis_state_ || !lis.stats().imu_initialized || lis.stats().scans_processed < 5) return std::nullopt;
+  const Trajectory& imu_rate = lis.imuRateTrajectory();
+  const std::optional<Eigen::Isometry3d> T = lisPoseAt(imu_rate, t);
+  const std::optional<Eigen::Isometry3d> T_before = lisPoseAt(imu_rate, t - 40'000'000);
+  if (!T || !T_before) return std::nullopt;
+  vio::SeedState s;
+  s.T_world_imu = *T;
+  s.v_world = (T->translation() - T_before->translation()) / 0.04;
+  s.bias.gyro = lis_state_->gyro_bias;
+  s.bias.acc = lis_state_->acc_bias;
+  return s;
+}
+
+void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis) {
+  ++frames_in_;
+  vio::VisualOdometry::PoseAt pose_at;
+  vio::Seeder seed;
+  if (lis != nullptr) {
+    pose_at = [lis](Time t) { return lisPoseAt(lis->imuRateTrajectory(), t); };
+    seed = [this, lis](Time t) { return seedAt(t, *lis); };
+  }
+  vio::VisFrame f;
+  try {
+    f = vo_->addFrame(frame, pose_at, seed);
+  } catch (const std::invalid_argument& e) {  // wrong size or type, a stamp not after the previous frame's
+    if (++frames_bad_ <= 5) spdlog::warn("camera frame {} skipped: {}", frame.source, e.what());
+    if (frames_bad_ == 5) spdlog::warn("camera: further skipped frames are counted, not shown");
+    return;
+  }
+  const vio::FrameResult& r = f.estimate;
+  if (r.reset) {
+    ++resets_;
+    spdlog::warn("VIS reset at {:.3f} s: {}", toSeconds(r.t), r.event);
+    if (events_.size() < kMaxEvents) events_.push_back({r.t, "reset", r.event});
+  } else if (r.just_initialized) {
+    if (!first_init_) first_init_ = r.t;
+    spdlog::info("VIS {} at {:.3f} s", r.event, toSeconds(r.t));
+    if (events_.size() < kMaxEvents) events_.push_back({r.t, "initialized", r.event});
+  } else if (!r.initialized && !r.event.empty()) {
+    waiting_ = r.event;
+  }
+  if (r.initialized) trajectory_.push_back({r.t, r.T_world_imu});
+  records_.push_back({r.t, r.initialized, r.keyframe, f.detected, f.front_tracked, r.features, r.with_lidar_depth,
+                      r.outliers, r.iterations, vo_->estimator().featuresInThreeOrMore(), f.ms});
+}
+
+Json RunVis::report() const {
+  Json j;
+  j["detector"] = detector_name_;
+  j["depth_mode"] = vio::toString(vio_config_.depth_mode);
+  j["init_mode"] = vio::toString(vio_config_.init);
+  j["frames_in"] = frames_in_;
+  j["frames_bad"] = frames_bad_;
+  j["frames_estimated"] = trajectory_.size();
+  j["initialized"] = first_init_.has_value();
+  if (first_init_) j["first_init_s"] = toSeconds(*first_init_);
+  if (!first_init_) j["not_initialized_because"] = waiting_;
+  j["resets"] = resets_;
+  j["time_offset_s"] = vo_->estimator().timeOffset();
+  Json events = Json::array();
+  for (const Event& e : events_) events.push_back({{"t", toSeconds(e.t)}, {"kind", e.kind}, {"what", e.what}});
+  j["events"] = events;
+  // Means over the frames, and per frame (compact columns).
+  double track = 0, depth = 0, solve = 0, marg = 0, total = 0, tracked = 0, with_depth = 0, three = 0;
+  std::size_t n = 0, keyframes = 0, detected = 0;
+  Json frames = Json::array();
+  for (const VisFrameRecord& r : records_) {
+    track += r.ms.track, depth += r.ms.depth, solve += r.ms.solve, marg += r.ms.marginalize, total += r.ms.total;
+    tracked += r.tracked, with_depth += r.with_depth, three += r.share_three;
+    keyframes += r.keyframe ? 1 : 0;
+    detected += r.detected ? 1 : 0;
+    ++n;
+    frames.push_back({toSeconds(r.t), r.initialized, r.tracked, r.features, r.with_depth, r.keyframe, r.outliers,
+                      r.ms.total});
+  }
+  const double d = n > 0 ? static_cast<double>(n) : 1.0;
+  j["keyframes"] = keyframes;
+  j["frames_detected"] = detected;
+  j["mean"] = {{"tracked", tracked / d},
+               {"features_with_lidar_depth", with_depth / d},
+               {"share_features_in_3_or_more_frames", three / d}};
+  j["ms_per_frame"] = {{"track", track / d}, {"depth", depth / d}, {"solve", solve / d},
+                       {"marginalize", marg / d}, {"total", total / d}};
+  j["frame_columns"] = {"t", "initialized", "tracked", "features", "with_lidar_depth", "keyframe", "outliers", "ms"};
+  j["frames"] = frames;
+  return j;
+}
+
+}  // namespace drover::cli

@@ -1,0 +1,66 @@
+#pragma once
+// The VIS inside `drover run`: feeds vio::VisualOdometry with the dataset's IMU and camera frames and, when the
+// LIS runs, with its deskewed sweeps (lidar depth) and its states (initialisation); keeps the VIS trajectory and
+// per-frame records for trajectory_vis.tum and report.json's "vis" section.
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "io/reader.hpp"
+#include "pipeline/lidar_odometry.hpp"
+#include "types/trajectory.hpp"
+#include "vio/visual_odometry.hpp"
+
+namespace drover::cli {
+
+struct VisFrameRecord {
+  Time t = 0;
+  bool initialized = false, keyframe = false, detected = false;
+  int tracked = 0, features = 0, with_depth = 0, outliers = 0, iterations = 0;
+  double share_three = 0;  // of the solved features, seen in >= 3 window frames
+  vio::VisStageMs ms;
+};
+
+class RunVis {
+ public:
+  // Reads the `visual:` and `vio:` sections of the platform config (defaults without one).
+  RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu);
+  ~RunVis();
+
+  void onImu(const ImuSample& sample);
+  // A camera frame; lis is the LIS when it runs (nullptr with --no-lidar). A bad image is a counted warning.
+  void onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis);
+  // Every sweep the LIS processed (registered with LidarOdometry::setSweepListener).
+  void onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points_lidar);
+  // The newest LIS sweep with a fused IMU state (its velocity and biases seed the VIS).
+  void onLisState(const pipeline::ScanOutcome& outcome);
+
+  const Trajectory& trajectory() const { return trajectory_; }  // T_world_imu at every initialised frame
+  const std::string& detectorName() const { return detector_name_; }
+  // report.json's "vis" section (without the APE, which the caller adds).
+  nlohmann::json report() const;
+  std::size_t framesIn() const { return frames_in_; }
+
+ private:
+  std::optional<vio::SeedState> seedAt(Time t, const pipeline::LidarOdometry& lis) const;
+
+  std::unique_ptr<vio::VisualOdometry> vo_;
+  std::string detector_name_;
+  vio::VioConfig vio_config_;
+  Trajectory trajectory_;
+  std::vector<VisFrameRecord> records_;
+  struct Event {
+    Time t;
+    std::string kind, what;
+  };
+  std::vector<Event> events_;        // initialisations and resets (and the last "waiting" reason)
+  std::string waiting_;              // why the VIS has not initialised yet (the newest reason)
+  std::optional<pipeline::ScanOutcome> lis_state_;
+  std::size_t frames_in_ = 0, frames_bad_ = 0, resets_ = 0;
+  std::optional<Time> first_init_;
+};
+
+}  // namespace drover::cli

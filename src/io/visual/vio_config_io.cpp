@@ -1,0 +1,74 @@
+#include "io/visual/vio_config_io.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include "io/error.hpp"
+#include "io/text_parsing.hpp"
+#include "io/user_values.hpp"
+#include "io/yaml_section.hpp"
+
+namespace drover::io {
+namespace {
+
+vio::DepthMode parseDepthMode(const std::string& s) {  // already checked by bindChoice
+  if (s == "factor") return vio::DepthMode::kFactor;
+  if (s == "off") return vio::DepthMode::kOff;
+  return vio::DepthMode::kFixed;
+}
+
+vio::InitMode parseInitMode(const std::string& s) {
+  if (s == "lis") return vio::InitMode::kLis;
+  if (s == "visual") return vio::InitMode::kVisual;
+  return vio::InitMode::kAuto;
+}
+
+}  // namespace
+
+vio::VioConfig loadVioConfig(const std::string& yaml_path) {
+  const YAML::Node root = loadConfigRoot(yaml_path);
+  vio::VioConfig c;
+  if (root.IsNull()) return c;
+  std::string depth_mode = vio::toString(c.depth_mode), init = vio::toString(c.init);
+  YamlSection s(yaml_path, "vio");
+  s.bind("window", c.window)
+      .bind("min_parallax_px", c.min_parallax_px)
+      .bind("min_tracked_for_parallax", c.min_tracked_for_parallax)
+      .bind("focal_px", c.focal_px)
+      .bind("sigma_px", c.sigma_px)
+      .bind("robust_px", c.robust_px)
+      .bind("outlier_px", c.outlier_px)
+      .bind("min_observations", c.min_observations)
+      .bind("max_features", c.max_features)
+      .bindChoice("depth_mode", depth_mode, {"fixed", "factor", "off"})
+      .bind("depth_sigma_m", c.depth_sigma_m)
+      .bind("depth_sigma_rel", c.depth_sigma_rel)
+      .bind("depth_sigma_spread", c.depth_sigma_spread)
+      .bind("max_iterations", c.max_iterations)
+      .bind("max_solver_ms", c.max_solver_ms)
+      .bind("estimate_extrinsic", c.estimate_extrinsic)
+      .bind("estimate_time_offset", c.estimate_time_offset)
+      .bindSeconds("max_time_offset_s", c.max_time_offset_s, positive("s"))
+      .bindChoice("init", init, {"auto", "lis", "visual"})
+      .bind("init_min_parallax_px", c.init_min_parallax_px)
+      .bind("init_min_acc_excitation", c.init_min_acc_excitation)
+      .bind("min_tracked", c.min_tracked)
+      .bind("max_acc_bias", c.max_acc_bias)
+      .bind("max_gyro_bias", c.max_gyro_bias)
+      .bind("max_jump_m", c.max_jump_m)
+      .bind("max_height_jump_m", c.max_height_jump_m)
+      .bind("max_turn_deg", c.max_turn_deg)
+      .bind("max_speed", c.max_speed)
+      .bindSeconds("max_imu_gap_s", c.max_imu_gap_s, positive("s"));
+  const YAML::Node node = root["vio"];
+  s.apply(node);
+  c.depth_mode = parseDepthMode(depth_mode);
+  c.init = parseInitMode(init);
+  if (const std::string err = c.validate(); !err.empty()) {
+    const int line = node ? node.Mark().line : -1;
+    fail(yaml_path, (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) +
+                        "section 'vio'", err);
+  }
+  return c;
+}
+
+}  // namespace drover::io

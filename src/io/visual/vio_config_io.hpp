@@ -1,0 +1,21 @@
+#pragma once
+// The `vio:` section of a platform config -> vio::VioConfig (the VIS's sliding window). Every key is optional (left
+// out = the default in src/vio/vio_config.hpp, whose comments give the units); an unknown key or a bad value is an
+// IoError naming the file, the line and the dotted key. Keys:
+//   vio: window, min_parallax_px [px], min_tracked_for_parallax, focal_px [px], sigma_px [px], robust_px [px],
+//        outlier_px [px], min_observations, max_features, depth_mode (fixed | factor | off), depth_sigma_m [m],
+//        depth_sigma_rel, depth_sigma_spread, max_iterations, max_solver_ms [ms], estimate_extrinsic (bool),
+//        estimate_time_offset (bool), max_time_offset_s [s], init (auto | lis | visual), init_min_parallax_px [px],
+//        init_min_acc_excitation [m/s^2], min_tracked, max_acc_bias [m/s^2], max_gyro_bias [rad/s],
+//        max_jump_m [m], max_height_jump_m [m], max_turn_deg [deg], max_speed [m/s], max_imu_gap_s [s]
+#include <string>
+
+#include "vio/vio_config.hpp"
+
+namespace drover::io {
+
+// Throws IoError (file, line, key) for a missing file, invalid YAML, unknown key, bad value or a config that fails
+// VioConfig::validate().
+vio::VioConfig loadVioConfig(const std::string& yaml_path);
+
+}  // namespace drover::io

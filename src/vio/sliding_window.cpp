@@ -1,0 +1,248 @@
+// Frame bookkeeping of the sliding window: IMU intervals, prediction, the keyframe decision, initialisation and
+// sliding. The solve and the marginalisation are in window_optimize.cpp and window_marginalize.cpp.
+#include "vio/sliding_window.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "backend/schur_marginalizer.hpp"
+#include "vio/window_frame.hpp"
+
+namespace drover::vio {
+
+SlidingWindowEstimator::SlidingWindowEstimator(const VioConfig& config, const imu::PreintegrationConfig& imu_config,
+                                               const Eigen::Isometry3d& T_imu_cam, double focal_px)
+    : config_(config), imu_config_(imu_config), focal_px_(focal_px) {
+  if (const std::string bad = config.validate(); !bad.empty()) throw std::invalid_argument("vio: " + bad);
+  if (const std::string bad = imu_config.validate(); !bad.empty()) throw std::invalid_argument("vio imu: " + bad);
+  if (!(focal_px > 0) || !std::isfinite(focal_px)) throw std::invalid_argument("vio: focal length must be > 0");
+  const Eigen::Quaterniond q(T_imu_cam.rotation());
+  q_ic_[0] = q.x(), q_ic_[1] = q.y(), q_ic_[2] = q.z(), q_ic_[3] = q.w();
+  Eigen::Map<Eigen::Vector3d>(p_ic_) = T_imu_cam.translation();
+}
+
+SlidingWindowEstimator::~SlidingWindowEstimator() = default;
+
+Eigen::Isometry3d SlidingWindowEstimator::T_imu_cam() const {
+  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+  T.linear() = Eigen::Quaterniond(q_ic_[3], q_ic_[0], q_ic_[1], q_ic_[2]).normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(p_ic_[0], p_ic_[1], p_ic_[2]);
+  return T;
+}
+
+Time SlidingWindowEstimator::imuTime(Time t_camera) const {
+  return t_camera + static_cast<Time>(std::llround(td_[0] * 1e9));
+}
+
+void SlidingWindowEstimator::addImu(const ImuSample& sample) {
+  if (!imu_.empty() && sample.t <= imu_.back().t) return;  // the caller checks order; never integrate backwards
+  imu_.push_back(sample);
+}
+
+// The samples that cover [t0, t1] (the last one at or before t0 first) and the buffer pruned to the last sample at
+// or before t1, which starts the next interval.
+std::vector<ImuSample> SlidingWindowEstimator::takeImu(Time t0, Time t1) {
+  std::vector<ImuSample> out;
+  auto first = std::upper_bound(imu_.begin(), imu_.end(), t0, [](Time t, const ImuSample& s) { return t < s.t; });
+  if (first == imu_.begin()) return out;  // nothing at or before t0: the interval is not covered
+  --first;
+  auto last = std::upper_bound(imu_.begin(), imu_.end(), t1, [](Time t, const ImuSample& s) { return t < s.t; });
+  out.assign(first, last);
+  if (last != imu_.begin()) imu_.erase(imu_.begin(), std::prev(last));
+  return out;
+}
+
+namespace {
+// [s] the longest stretch of [t0, t1] without an IMU sample (infinite when none is at or before t0).
+double largestGap(const std::vector<ImuSample>& samples, Time t0, Time t1) {
+  if (samples.empty() || samples.front().t > t0) return std::numeric_limits<double>::infinity();
+  double gap = toSeconds(t1 - samples.back().t);
+  for (std::size_t k = 1; k < samples.size(); ++k) gap = std::max(gap, toSeconds(samples[k].t - samples[k - 1].t));
+  return gap;
+}
+}  // namespace
+
+void SlidingWindowEstimator::integrate(Frame& frame, const Frame& previous) const {
+  frame.pre.emplace(previous.imuBias(), imu_config_);
+  frame.pre->integrateRange(frame.imu, previous.t, frame.t);
+}
+
+// Forster et al. Eq. 38: the new frame's state from the previous one and the preintegration.
+void SlidingWindowEstimator::predict(Frame& frame, const Frame& previous) const {
+  const imu::Preintegrator& pre = *frame.pre;
+  const double dt = pre.deltaTime();
+  const Eigen::Vector3d g(0, 0, -imu_config_.gravity);
+  const Eigen::Isometry3d Ti = previous.pose();
+  const Eigen::Matrix3d& Ri = Ti.linear();
+  Eigen::Isometry3d Tj = Eigen::Isometry3d::Identity();
+  Tj.linear() = Ri * pre.deltaR();
+  Tj.translation() = Ti.translation() + previous.velocity() * dt + 0.5 * g * dt * dt + Ri * pre.deltaP();
+  frame.setPose(Tj);
+  frame.setVelocity(previous.velocity() + g * dt + Ri * pre.deltaV());
+  frame.setBias(previous.imuBias());
+}
+
+std::vector<Eigen::Isometry3d> SlidingWindowEstimator::cameraPoses() const {
+  std::vector<Eigen::Isometry3d> out;
+  const Eigen::Isometry3d T_ic = T_imu_cam();
+  for (const auto& f : frames_) out.push_back(f->pose() * T_ic);
+  return out;
+}
+
+void SlidingWindowEstimator::reset() {
+  frames_.clear();
+  features_.clear();
+  prior_.reset();
+  initialized_ = false;
+  last_output_.reset();
+}
+
+FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<FrameFeature>& features,
+                                             const Seeder& seed) {
+  FrameResult result;
+  result.t = imuTime(t_camera);
+  if (!frames_.empty() && result.t <= frames_.back()->t) {
+    result.event = "frame stamp not after the previous frame's: skipped";
+    if (last_output_) result.initialized = initialized_;
+    return result;
+  }
+  auto frame = std::make_unique<Frame>();
+  frame->t = result.t;
+  frame->imu = takeImu(frames_.empty() ? result.t : frames_.back()->t, result.t);
+  if (!frames_.empty()) {
+    const double gap = largestGap(frame->imu, frames_.back()->t, result.t);
+    if (gap > config_.max_imu_gap_s) {
+      const bool was = initialized_;
+      reset();
+      result.reset = was;
+      result.event = std::isinf(gap) ? "no IMU data covers the interval since the previous frame: window cleared"
+                                     : fmt::format("no IMU data for {:.3f} s before the frame: window cleared", gap);
+    }
+  }
+  for (const FrameFeature& f : features) frame->seen.emplace(f.id, f.normalized);
+  const int index = static_cast<int>(frames_.size());
+  const double parallax = features_.addFrame(index, features, td_[0]);
+  result.tracked = features_.lastTracked();
+  const bool keyframe = index < 2 || parallax < 0 || result.tracked < config_.min_tracked_for_parallax ||
+                        parallax * config_.focal_px >= config_.min_parallax_px;
+  if (!frames_.empty()) {
+    integrate(*frame, *frames_.back());
+    if (initialized_) predict(*frame, *frames_.back());
+  }
+  frames_.push_back(std::move(frame));
+
+  if (!initialized_) {
+    if (!tryInitialize(seed, result)) {
+      if (static_cast<int>(frames_.size()) > config_.window) slide(keyframe, result);
+      return result;
+    }
+  }
+  optimize(result);
+  removeOutliers(result);
+  if (const std::string why = failure(result); !why.empty()) {
+    reset();
+    result.reset = true;
+    result.initialized = false;
+    result.event = why + ": window cleared, re-initialising";
+    return result;
+  }
+  fillResult(result);
+  last_output_ = result;
+  if (static_cast<int>(frames_.size()) > config_.window) slide(keyframe, result);
+  return result;
+}
+
+bool SlidingWindowEstimator::tryInitialize(const Seeder& seed, FrameResult& result) {
+  const int have = static_cast<int>(frames_.size());
+  if (have <= config_.window) {
+    if (result.event.empty())
+      result.event = fmt::format("initialising: window {} of {} frames", have, config_.window + 1);
+    return false;
+  }
+  std::string why;
+  bool ok = false;
+  const bool seed_ready = seed && seed(frames_.front()->t) && seed(frames_.back()->t);
+  if (config_.init == InitMode::kLis || (config_.init == InitMode::kAuto && seed_ready)) {
+    ok = initializeFromSeed(seed, why);
+    if (ok) result.event = "initialised from the LIS";
+  } else {
+    ok = initializeVisually(why);
+    if (ok) result.event = "initialised by visual-inertial alignment: " + why;
+  }
+  if (!ok) {
+    result.event = "not initialised: " + why;
+    return false;
+  }
+  initialized_ = true;
+  result.just_initialized = true;
+  return true;
+}
+
+bool SlidingWindowEstimator::initializeFromSeed(const Seeder& seed, std::string& why) {
+  if (!seed) {
+    why = "no LIS runs (init: lis needs the lidar)";
+    return false;
+  }
+  std::vector<SeedState> states;
+  for (const auto& f : frames_) {
+    std::optional<SeedState> s = seed(f->t);
+    if (!s) {
+      why = fmt::format("waiting for the LIS: it has no state at {:.3f} s", toSeconds(f->t));
+      return false;
+    }
+    states.push_back(*s);
+  }
+  for (std::size_t k = 0; k < frames_.size(); ++k) {
+    frames_[k]->setPose(states[k].T_world_imu);
+    frames_[k]->setVelocity(states[k].v_world);
+    frames_[k]->setBias(states[k].bias);
+    if (k > 0) integrate(*frames_[k], *frames_[k - 1]);
+  }
+  features_.initializeDepths(cameraPoses(), config_.depth_mode != DepthMode::kOff);
+  return true;
+}
+
+void SlidingWindowEstimator::fillResult(FrameResult& result) const {
+  const Frame& f = *frames_.back();
+  result.initialized = true;
+  result.T_world_imu = f.pose();
+  result.v_world = f.velocity();
+  result.bias = f.imuBias();
+  result.td = td_[0];
+}
+
+// One frame leaves: the oldest when the second-newest is a keyframe, else the second-newest (VINS slideWindow).
+void SlidingWindowEstimator::slide(bool keyframe, FrameResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  const bool use_lidar = config_.depth_mode != DepthMode::kOff;
+  result.keyframe = keyframe;
+  if (keyframe) {
+    if (initialized_) marginalizeOldest();
+    const Eigen::Isometry3d T_ic = T_imu_cam();
+    features_.removeOldest(frames_[0]->pose() * T_ic, frames_[1]->pose() * T_ic, use_lidar && initialized_);
+    frames_.pop_front();
+    frames_.front()->pre.reset();
+    frames_.front()->imu.clear();
+  } else {
+    if (initialized_) marginalizeSecondNewest();
+    const int newest = static_cast<int>(frames_.size()) - 1;
+    Frame& last = *frames_[static_cast<std::size_t>(newest)];
+    Frame& dropped = *frames_[static_cast<std::size_t>(newest - 1)];
+    std::vector<ImuSample> merged = dropped.imu;
+    for (const ImuSample& s : last.imu)
+      if (merged.empty() || s.t > merged.back().t) merged.push_back(s);
+    last.imu = std::move(merged);
+    frames_.erase(frames_.begin() + newest - 1);
+    integrate(last, *frames_[static_cast<std::size_t>(newest - 2)]);
+    features_.removeSecondNewest(newest);
+  }
+  result.ms_marginalize =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace drover::vio

@@ -1,0 +1,121 @@
+#pragma once
+// The sliding-window visual-inertial estimator (VINS-Mono, Qin et al. T-RO 2018, Sec. VI; LVI-SAM's lidar depth).
+// States per window frame: p_world_imu, q_world_imu, v_world, biases [b_g; b_a]; shared: T_imu_cam (optionally
+// refined) and the camera-IMU time offset td (optionally estimated; t_imu = t_camera + calibration offset + td);
+// per feature: its inverse depth in the anchor camera. Per frame the cost is
+//   marginal prior + sum IMU preintegration + bias random walk + sum rho(reprojection) [+ lidar inverse depth]
+// solved by Ceres (DENSE_SCHUR, dogleg, a bounded number of iterations), after which outliers are dropped, the
+// failure checks run, and one frame leaves the window by marginalisation: the oldest when the second-newest frame
+// is a keyframe (enough parallax or few tracked features), else the second-newest (its IMU folded into the next).
+// Before initialisation the window fills and slides without marginalisation; initialisation is from an external
+// seed (the LIS: poses, velocities and biases at the frames' stamps) or visual-inertial alignment (Sec. V).
+// Deterministic: no wall-clock limit unless config.max_solver_ms applies (live use), single-threaded solver.
+#include <Eigen/Geometry>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imu/preintegration.hpp"
+#include "types/imu.hpp"
+#include "vio/feature_manager.hpp"
+#include "vio/vio_config.hpp"
+
+namespace drover::backend {
+class MarginalPriorFactor;
+}
+
+namespace drover::vio {
+
+// An externally known state at a camera stamp (the LIS's IMU-rate state).
+struct SeedState {
+  Eigen::Isometry3d T_world_imu = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d v_world = Eigen::Vector3d::Zero();  // [m/s]
+  imu::ImuBias bias;
+};
+using Seeder = std::function<std::optional<SeedState>(Time)>;
+
+// What one frame did.
+struct FrameResult {
+  Time t = 0;                       // [ns] the frame's stamp in IMU time (with the estimated td)
+  bool initialized = false;         // the window is initialised and the state below is an estimate
+  bool just_initialized = false;
+  bool reset = false;               // a failure cleared the window at this frame
+  std::string event;                // why initialisation waits, how it succeeded, or why the window was reset
+  bool keyframe = false;            // the second-newest frame was kept (the oldest was marginalised)
+  int tracked = 0;                  // features of this frame already in the window
+  int features = 0;                 // features used in the solve
+  int with_lidar_depth = 0;         // of those, anchored on a lidar depth
+  int outliers = 0;                 // observations dropped after the solve
+  int iterations = 0;
+  double ms_solve = 0, ms_marginalize = 0;  // [ms]
+  Eigen::Isometry3d T_world_imu = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d v_world = Eigen::Vector3d::Zero();
+  imu::ImuBias bias;
+  double td = 0;                    // [s] estimated time offset on top of the calibration's
+};
+
+class SlidingWindowEstimator {
+ public:
+  // Throws std::invalid_argument when a config is invalid or focal_px <= 0.
+  SlidingWindowEstimator(const VioConfig& config, const imu::PreintegrationConfig& imu_config,
+                         const Eigen::Isometry3d& T_imu_cam, double focal_px);
+  ~SlidingWindowEstimator();
+  SlidingWindowEstimator(const SlidingWindowEstimator&) = delete;
+  SlidingWindowEstimator& operator=(const SlidingWindowEstimator&) = delete;
+
+  // IMU samples in time order (the caller checks them); a frame at t needs the samples up to t.
+  void addImu(const ImuSample& sample);
+  // One camera frame: t_camera in IMU time without td (stamp + calibration offset). seed may be empty (no LIS).
+  FrameResult addFrame(Time t_camera, const std::vector<FrameFeature>& features, const Seeder& seed);
+
+  bool initialized() const { return initialized_; }
+  double timeOffset() const { return td_[0]; }
+  Eigen::Isometry3d T_imu_cam() const;
+  int windowSize() const { return static_cast<int>(frames_.size()); }
+  // Share of the solved features observed in >= 3 window keyframes (the track-length question), last frame.
+  double featuresInThreeOrMore() const { return share_three_; }
+  void reset();  // clears everything (a failure, or the caller's reset)
+  // Live use: the solver stops at config.max_solver_ms (results then depend on timing). Replay: iterations only.
+  void setRealtime(bool realtime) { deterministic_ = !realtime; }
+
+ private:
+  struct Frame;
+  struct Residuals;
+  Time imuTime(Time t_camera) const;
+  std::vector<ImuSample> takeImu(Time t0, Time t1);
+  void integrate(Frame& frame, const Frame& previous) const;
+  void predict(Frame& frame, const Frame& previous) const;
+  bool tryInitialize(const Seeder& seed, FrameResult& result);
+  bool initializeFromSeed(const Seeder& seed, std::string& why);
+  bool initializeVisually(std::string& why);
+  std::vector<Eigen::Isometry3d> cameraPoses() const;
+  void optimize(FrameResult& result);
+  void buildResiduals(Residuals& r, bool for_marginalization_of_oldest) const;
+  void removeOutliers(FrameResult& result);
+  std::string failure(const FrameResult& previous_output) const;
+  void slide(bool keyframe, FrameResult& result);
+  void marginalizeOldest();
+  void marginalizeSecondNewest();
+  void fixGauge(const Eigen::Isometry3d& T_world_imu0_before);
+  void fillResult(FrameResult& result) const;
+
+  VioConfig config_;
+  imu::PreintegrationConfig imu_config_;
+  double focal_px_;
+  double p_ic_[3], q_ic_[4];  // T_imu_cam parameter blocks (q in Eigen x, y, z, w order)
+  double td_[1] = {0};        // [s]
+  std::deque<std::unique_ptr<Frame>> frames_;  // stable addresses: the marginal prior points into them
+  FeatureManager features_;
+  std::deque<ImuSample> imu_;
+  std::unique_ptr<backend::MarginalPriorFactor> prior_;
+  bool initialized_ = false;
+  std::optional<FrameResult> last_output_;
+  double share_three_ = 0;
+  bool deterministic_ = true;
+  bool solver_failed_ = false;
+};
+
+}  // namespace drover::vio

@@ -1,0 +1,63 @@
+#include "vio/vio_config.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace drover::vio {
+
+const char* toString(DepthMode mode) {
+  switch (mode) {
+    case DepthMode::kFixed:
+      return "fixed";
+    case DepthMode::kFactor:
+      return "factor";
+    case DepthMode::kOff:
+      break;
+  }
+  return "off";
+}
+
+const char* toString(InitMode mode) {
+  switch (mode) {
+    case InitMode::kLis:
+      return "lis";
+    case InitMode::kVisual:
+      return "visual";
+    case InitMode::kAuto:
+      break;
+  }
+  return "auto";
+}
+
+namespace {
+bool positive(double x) { return std::isfinite(x) && x > 0; }
+bool nonNegative(double x) { return std::isfinite(x) && x >= 0; }
+}  // namespace
+
+std::string VioConfig::validate() const {
+  if (window < 3 || window > 50) return "window must be in [3, 50] frames";
+  if (!positive(min_parallax_px)) return "min_parallax_px must be > 0";
+  if (min_tracked_for_parallax < 0) return "min_tracked_for_parallax must be >= 0";
+  if (!positive(focal_px)) return "focal_px must be > 0";
+  if (!positive(sigma_px)) return "sigma_px must be > 0";
+  if (!positive(robust_px)) return "robust_px must be > 0";
+  if (!positive(outlier_px)) return "outlier_px must be > 0";
+  if (min_observations < 2) return "min_observations must be >= 2";
+  if (max_features < 1) return "max_features must be >= 1";
+  if (!positive(depth_sigma_m) || !nonNegative(depth_sigma_rel) || !nonNegative(depth_sigma_spread))
+    return "depth_sigma_m must be > 0, depth_sigma_rel and depth_sigma_spread >= 0";
+  if (max_iterations < 1) return "max_iterations must be >= 1";
+  if (!nonNegative(max_solver_ms)) return "max_solver_ms must be >= 0";
+  if (!positive(max_time_offset_s)) return "max_time_offset_s must be > 0";
+  if (!positive(init_min_parallax_px)) return "init_min_parallax_px must be > 0";
+  if (!nonNegative(init_min_acc_excitation)) return "init_min_acc_excitation must be >= 0";
+  if (min_tracked < 0) return "min_tracked must be >= 0";
+  if (!positive(max_imu_gap_s)) return "max_imu_gap_s must be > 0";
+  if (!positive(max_acc_bias) || !positive(max_gyro_bias) || !positive(max_jump_m) || !positive(max_height_jump_m) ||
+      !positive(max_turn_deg) || !positive(max_speed))
+    return "the failure thresholds (max_acc_bias, max_gyro_bias, max_jump_m, max_height_jump_m, max_turn_deg, "
+           "max_speed) must be > 0";
+  return {};
+}
+
+}  // namespace drover::vio

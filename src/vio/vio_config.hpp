@@ -1,0 +1,59 @@
+#pragma once
+// Configuration of the visual-inertial odometry (the VIS): a VINS-Mono sliding window (Qin, Li, Shen, "VINS-Mono",
+// T-RO 2018, Sec. V-VI) with LVI-SAM's lidar depth (Shan et al., ICRA 2021, Sec. III-B). Units in the comments.
+#include <string>
+
+namespace drover::vio {
+
+// How the lidar depth of a feature enters the window (LVI-SAM holds it fixed).
+enum class DepthMode {
+  kFixed,   // the feature's inverse depth is set from the lidar and held constant (LVI-SAM)
+  kFactor,  // an inverse-depth factor with a sigma that grows with the association's spread and the depth
+  kOff,     // lidar depth is not used (monocular triangulation only)
+};
+const char* toString(DepthMode mode);
+
+// How the window is initialised.
+enum class InitMode {
+  kAuto,    // from the LIS when it runs and is initialised, else visual-inertial alignment
+  kLis,     // only from the LIS (waits for it)
+  kVisual,  // only by visual-inertial alignment (VINS-Mono Sec. V), even when a lidar runs
+};
+const char* toString(InitMode mode);
+
+struct VioConfig {
+  int window = 10;                 // keyframes in the window; the newest frame comes on top (VINS WINDOW_SIZE)
+  double min_parallax_px = 10;     // [px at focal_px] average parallax that makes a keyframe (VINS MIN_PARALLAX)
+  int min_tracked_for_parallax = 20;  // fewer features tracked from the previous frame: a keyframe (VINS: 20)
+  double focal_px = 460;           // [px] virtual focal length of the parallax test (VINS FOCAL_LENGTH)
+  double sigma_px = 1.5;           // [px] reprojection sigma at the camera's own focal length (VINS: 1.5 px)
+  double robust_px = 1.5;          // [px] Cauchy loss scale on the reprojection error (VINS: Cauchy(1) whitened)
+  double outlier_px = 3.0;         // [px] observations with a larger error after the solve are dropped
+  int min_observations = 2;        // a feature is used when seen in this many frames of the window (VINS: 2)
+  int max_features = 200;          // features in the solve (the longest tracks first)
+  DepthMode depth_mode = DepthMode::kFixed;
+  double depth_sigma_m = 0.05;     // [m] factor mode: sigma of a lidar depth at 1 m with no spread ...
+  double depth_sigma_rel = 0.02;   // ... plus this fraction of the depth ...
+  double depth_sigma_spread = 0.5; // ... plus this fraction of the 3 lidar neighbours' range spread [m]
+  int max_iterations = 8;          // Ceres iterations per frame (VINS NUM_ITERATIONS)
+  double max_solver_ms = 40;       // [ms] solver time limit per frame; only in live use (replay is deterministic)
+  bool estimate_extrinsic = false; // refine T_imu_cam online (VINS ESTIMATE_EXTRINSIC 1)
+  bool estimate_time_offset = true;  // estimate the camera-IMU time offset td (VINS ESTIMATE_TD)
+  double max_time_offset_s = 0.05; // [s] |td| above this is a failure
+  InitMode init = InitMode::kAuto;
+  // Visual-inertial alignment (no lidar): VINS-Mono's thresholds.
+  double init_min_parallax_px = 30;     // [px at focal_px] relative-pose pair
+  double init_min_acc_excitation = 0.25;  // [m/s^2] std of the window's average accelerations
+  // Failure detection (VINS-Mono failureDetection).
+  int min_tracked = 8;             // fewer features tracked into the newest frame: failure
+  double max_acc_bias = 2.5;       // [m/s^2]
+  double max_gyro_bias = 1.0;      // [rad/s]
+  double max_jump_m = 5.0;         // [m] position change between consecutive frames
+  double max_height_jump_m = 1.0;  // [m] z change between consecutive frames
+  double max_turn_deg = 50.0;      // [deg] rotation between consecutive frames
+  double max_speed = 50.0;         // [m/s]
+  double max_imu_gap_s = 0.1;      // [s] a longer stretch without IMU samples between frames clears the window
+  std::string validate() const;    // empty = valid, else names the bad value
+};
+
+}  // namespace drover::vio

@@ -1,0 +1,69 @@
+#pragma once
+// The VIS driven frame by frame in time order (the deterministic replay of `drover run`): the KLT front end
+// (visual::FeatureTracker with the configured detector), LVI-SAM's lidar depth for the tracked features
+// (visual::DepthAssociator over the LIS's recent deskewed sweeps), and the sliding-window estimator.
+// The LIS plugs in through two callbacks: its IMU pose at a camera stamp (to put the lidar points into the camera)
+// and its full state there (to seed the window). Without a lidar both are empty and the VIS runs alone.
+#include <Eigen/Geometry>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "imu/preintegration.hpp"
+#include "types/calibration.hpp"
+#include "types/camera.hpp"
+#include "visual/depth_association.hpp"
+#include "visual/feature_tracker.hpp"
+#include "vio/sliding_window.hpp"
+
+namespace drover::vio {
+
+struct VisConfig {
+  VioConfig vio;
+  visual::FeatureTrackerConfig tracker;
+  visual::DepthAssociationConfig depth;
+};
+
+struct VisStageMs {  // [ms] wall time per stage of one frame
+  double track = 0, depth = 0, solve = 0, marginalize = 0, total = 0;
+};
+
+struct VisFrame {
+  FrameResult estimate;
+  int front_tracked = 0;     // features the front end carried from the previous frame
+  int front_added = 0;       // new features from the detector
+  int depth_associated = 0;  // features with a lidar depth this frame
+  bool detected = false;     // the detector ran on this frame
+  VisStageMs ms;
+};
+
+class VisualOdometry {
+ public:
+  using PoseAt = std::function<std::optional<Eigen::Isometry3d>(Time)>;  // T_world_imu of the LIS at t
+  // Throws std::invalid_argument on an invalid config or calibration, or a null detector.
+  VisualOdometry(const VisConfig& config, const Calibration& calibration, const imu::PreintegrationConfig& imu_config,
+                 std::shared_ptr<visual::KeypointDetector> detector);
+  ~VisualOdometry();
+
+  void addImu(const ImuSample& sample);
+  // A deskewed sweep from the LIS: its points in the lidar frame at its start t, and the lidar's pose there.
+  void addSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points_lidar);
+  // One camera frame. Throws std::invalid_argument on an image of the wrong size or type (the caller warns and
+  // skips it).
+  VisFrame addFrame(const CameraFrame& frame, const PoseAt& lis_pose, const Seeder& seed);
+  const SlidingWindowEstimator& estimator() const { return estimator_; }
+  void setRealtime(bool realtime) { estimator_.setRealtime(realtime); }
+
+ private:
+  VisConfig config_;
+  Calibration calibration_;
+  visual::CameraModel camera_;
+  visual::FeatureTracker tracker_;
+  visual::DepthAssociator depth_;
+  SlidingWindowEstimator estimator_;
+  Time last_sweep_t_ = 0;
+};
+
+}  // namespace drover::vio

@@ -1,0 +1,118 @@
+// Marginalisation of the frame that leaves the window (VINS-Mono Sec. VI-D) and the failure checks (VINS-Mono's
+// failureDetection).
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "backend/quaternion_manifold.hpp"
+#include "backend/schur_marginalizer.hpp"
+#include "backend/visual_factors.hpp"
+#include "vio/window_frame.hpp"
+#include "vio/window_residuals.hpp"
+
+namespace drover::vio {
+namespace {
+
+const backend::RightQuaternionManifold& quaternionManifold() {
+  static const backend::RightQuaternionManifold manifold;
+  return manifold;
+}
+
+// A held (depth_mode fixed) lidar depth is conditioned on, not marginalised: a tight inverse-depth factor makes the
+// Schur complement keep the information the fixed depth gave (1 mm at 1 m).
+constexpr double kHeldDepthSigma = 1e-3;  // [m per m of depth]
+
+}  // namespace
+
+// Declares every block the window can put into a residual.
+static void declareBlocks(backend::SchurMarginalizer& m, const std::vector<double*>& frame_blocks_p,
+                          const std::vector<double*>& frame_blocks_q, const std::vector<double*>& frame_blocks_v,
+                          const std::vector<double*>& frame_blocks_b) {
+  for (std::size_t k = 0; k < frame_blocks_p.size(); ++k) {
+    m.addBlock(frame_blocks_p[k], 3, nullptr);
+    m.addBlock(frame_blocks_q[k], 4, &quaternionManifold());
+    m.addBlock(frame_blocks_v[k], 3, nullptr);
+    m.addBlock(frame_blocks_b[k], 6, nullptr);
+  }
+}
+
+void SlidingWindowEstimator::marginalizeOldest() {
+  backend::SchurMarginalizer m;
+  std::vector<double*> P, Q, V, B;
+  for (auto& f : frames_) P.push_back(f->p), Q.push_back(f->q), V.push_back(f->v), B.push_back(f->bias);
+  declareBlocks(m, P, Q, V, B);
+  m.addBlock(p_ic_, 3, nullptr);
+  m.addBlock(q_ic_, 4, &quaternionManifold());
+  m.addBlock(td_, 1, nullptr);
+  Residuals r;
+  buildResiduals(r, true);
+  for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
+  std::vector<std::unique_ptr<ceres::CostFunction>> held;
+  for (auto& [id, f] : features_.features())
+    if (r.fixed_depths.count(&f.inverse_depth))
+      held.push_back(std::make_unique<backend::InverseDepthFactor>(f.depth, kHeldDepthSigma * f.depth));
+  if (prior_) m.addResidual(prior_.get(), nullptr, prior_->blocks());
+  for (auto& item : r.items) m.addResidual(item.cost.get(), item.loss, item.blocks);
+  std::size_t h = 0;
+  for (auto& [id, f] : features_.features())
+    if (r.fixed_depths.count(&f.inverse_depth)) m.addResidual(held[h++].get(), nullptr, {&f.inverse_depth});
+  std::set<const double*> drop{P[0], Q[0], V[0], B[0]};
+  for (double* d : r.inverse_depths) drop.insert(d);
+  backend::MarginalResult result = m.marginalize(drop);
+  if (result.ok) prior_ = std::make_unique<backend::MarginalPriorFactor>(std::move(result));
+  else prior_.reset();  // the window then floats on its IMU and features until the next marginalisation
+}
+
+// The second-newest frame's visual measurements are dropped; only the prior, when it holds that frame, is
+// marginalised (VINS-Mono MARGIN_SECOND_NEW). Its IMU interval is merged into the newest by the caller.
+void SlidingWindowEstimator::marginalizeSecondNewest() {
+  if (!prior_) return;
+  const Frame& f = *frames_[frames_.size() - 2];
+  const std::vector<double*>& kept = prior_->blocks();
+  std::set<const double*> drop;
+  for (const double* b : {f.p, f.q, f.v, f.bias})
+    if (std::find(kept.begin(), kept.end(), b) != kept.end()) drop.insert(b);
+  if (drop.empty()) return;
+  backend::SchurMarginalizer m;
+  std::vector<double*> P, Q, V, B;
+  for (auto& fr : frames_) P.push_back(fr->p), Q.push_back(fr->q), V.push_back(fr->v), B.push_back(fr->bias);
+  declareBlocks(m, P, Q, V, B);
+  m.addBlock(p_ic_, 3, nullptr);
+  m.addBlock(q_ic_, 4, &quaternionManifold());
+  m.addBlock(td_, 1, nullptr);
+  m.addResidual(prior_.get(), nullptr, kept);
+  backend::MarginalResult result = m.marginalize(drop);
+  if (result.ok) prior_ = std::make_unique<backend::MarginalPriorFactor>(std::move(result));
+  else prior_.reset();
+}
+
+// VINS-Mono failureDetection, plus a solver failure and an implausible time offset. Empty when healthy.
+std::string SlidingWindowEstimator::failure(const FrameResult& result) const {
+  const Frame& f = *frames_.back();
+  if (solver_failed_) return "the solver failed";
+  if (!result.just_initialized && result.tracked < config_.min_tracked)
+    return fmt::format("only {} features tracked into the frame (< {})", result.tracked, config_.min_tracked);
+  const imu::ImuBias b = f.imuBias();
+  if (!b.acc.allFinite() || !f.pose().matrix().allFinite() || !f.velocity().allFinite()) return "non-finite state";
+  if (b.acc.norm() > config_.max_acc_bias)
+    return fmt::format("accelerometer bias {:.2f} m/s^2 > {:.2f}", b.acc.norm(), config_.max_acc_bias);
+  if (b.gyro.norm() > config_.max_gyro_bias)
+    return fmt::format("gyro bias {:.2f} rad/s > {:.2f}", b.gyro.norm(), config_.max_gyro_bias);
+  if (f.velocity().norm() > config_.max_speed)
+    return fmt::format("speed {:.1f} m/s > {:.1f}", f.velocity().norm(), config_.max_speed);
+  if (std::abs(td_[0]) > config_.max_time_offset_s)
+    return fmt::format("time offset {:.1f} ms beyond {:.1f} ms", td_[0] * 1e3, config_.max_time_offset_s * 1e3);
+  if (!last_output_) return {};
+  const Eigen::Isometry3d T = f.pose();
+  const Eigen::Isometry3d& L = last_output_->T_world_imu;
+  const double jump = (T.translation() - L.translation()).norm();
+  if (jump > config_.max_jump_m) return fmt::format("position jumped {:.2f} m between frames", jump);
+  const double dz = std::abs(T.translation().z() - L.translation().z());
+  if (dz > config_.max_height_jump_m) return fmt::format("height jumped {:.2f} m between frames", dz);
+  const double turn = Eigen::AngleAxisd(L.linear().transpose() * T.linear()).angle() * 180.0 / M_PI;
+  if (turn > config_.max_turn_deg) return fmt::format("heading jumped {:.1f} deg between frames", turn);
+  return {};
+}
+
+}  // namespace drover::vio

@@ -1,0 +1,185 @@
+// The window's nonlinear least squares (VINS-Mono Sec. VI, Eq. 22): marginal prior, IMU preintegration and bias
+// random walk, robust reprojection of every usable feature, and LVI-SAM's lidar depth; then outliers and gauge.
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "backend/imu_factors.hpp"
+#include "backend/quaternion_manifold.hpp"
+#include "backend/schur_marginalizer.hpp"
+#include "backend/visual_factors.hpp"
+#include "vio/window_frame.hpp"
+#include "vio/window_residuals.hpp"
+
+namespace drover::vio {
+namespace {
+
+// VINS-Mono repropagates a preintegration when the bias moved this far from its linearisation point.
+constexpr double kRepropagateAcc = 0.10;   // [m/s^2]
+constexpr double kRepropagateGyro = 0.01;  // [rad/s]
+
+double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
+
+const backend::RightQuaternionManifold& quaternionManifold() {
+  static const backend::RightQuaternionManifold manifold;
+  return manifold;
+}
+
+}  // namespace
+
+void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) const {
+  r.robust = std::make_unique<ceres::CauchyLoss>(config_.robust_px / config_.sigma_px);
+  const std::size_t n = frames_.size();
+  for (std::size_t k = 1; k < n; ++k) {
+    if (oldest_only && k > 1) break;
+    Frame& a = *frames_[k - 1];
+    Frame& b = *frames_[k];
+    if (!b.pre || b.pre->deltaTime() <= 0) continue;
+    r.items.push_back({std::make_unique<backend::ImuPreintegrationFactor>(*b.pre), nullptr,
+                       {a.p, a.q, a.v, a.bias, b.p, b.q, b.v, b.bias}});
+    r.items.push_back({std::make_unique<backend::BiasRandomWalkFactor>(imu_config_.gyro_bias_random_walk,
+                                                                       imu_config_.acc_bias_random_walk,
+                                                                       b.pre->deltaTime()),
+                       nullptr, {a.bias, b.bias}});
+  }
+  // The longest tracks first (they constrain the window most), up to max_features.
+  std::vector<Feature*> used;
+  const int newest = static_cast<int>(n) - 1;
+  for (auto& [id, f] : const_cast<FeatureManager&>(features_).features())
+    if (features_.usable(f, newest, config_.min_observations) && f.depth > 0 && (!oldest_only || f.start() == 0))
+      used.push_back(&f);
+  std::stable_sort(used.begin(), used.end(), [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
+  if (static_cast<int>(used.size()) > config_.max_features) used.resize(static_cast<std::size_t>(config_.max_features));
+  const double sqrt_info = focal_px_ / config_.sigma_px;
+  double* p_ic = const_cast<double*>(p_ic_);
+  double* q_ic = const_cast<double*>(q_ic_);
+  double* td = const_cast<double*>(td_);
+  for (Feature* f : used) {
+    f->inverse_depth = 1.0 / f->depth;
+    r.inverse_depths.insert(&f->inverse_depth);
+    ++r.features;
+    r.seen_three_times += f->obs.size() >= 3 ? 1 : 0;
+    const Observation& oi = f->obs.front();
+    Frame& fi = *frames_[static_cast<std::size_t>(oi.frame)];
+    for (std::size_t k = 1; k < f->obs.size(); ++k) {
+      const Observation& oj = f->obs[k];
+      Frame& fj = *frames_[static_cast<std::size_t>(oj.frame)];
+      r.items.push_back({std::make_unique<backend::ReprojectionFactor>(oi.normalized, oj.normalized, oi.velocity,
+                                                                       oj.velocity, oi.td, oj.td, sqrt_info),
+                         r.robust.get(), {fi.p, fi.q, fj.p, fj.q, p_ic, q_ic, &f->inverse_depth, td}});
+    }
+    if (!f->lidar_anchor) continue;
+    ++r.with_lidar_depth;
+    if (config_.depth_mode == DepthMode::kFixed) {
+      r.fixed_depths.insert(&f->inverse_depth);
+    } else if (config_.depth_mode == DepthMode::kFactor) {
+      const double sigma = config_.depth_sigma_m + config_.depth_sigma_rel * f->depth +
+                           config_.depth_sigma_spread * oi.depth_spread;
+      r.items.push_back({std::make_unique<backend::InverseDepthFactor>(f->depth, sigma), nullptr,
+                         {&f->inverse_depth}});
+    }
+  }
+}
+
+void SlidingWindowEstimator::optimize(FrameResult& result) {
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t k = 1; k < frames_.size(); ++k) {  // relinearise preintegrations whose bias moved far
+    const imu::ImuBias now = frames_[k - 1]->imuBias();
+    const imu::ImuBias& hat = frames_[k]->pre->biasHat();
+    if ((now.acc - hat.acc).norm() > kRepropagateAcc || (now.gyro - hat.gyro).norm() > kRepropagateGyro)
+      integrate(*frames_[k], *frames_[k - 1]);
+  }
+  features_.initializeDepths(cameraPoses(), config_.depth_mode != DepthMode::kOff);
+  const Eigen::Isometry3d T0_before = frames_.front()->pose();
+
+  Residuals r;
+  buildResiduals(r, false);
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  po.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  auto* manifold = const_cast<backend::RightQuaternionManifold*>(&quaternionManifold());
+  for (auto& f : frames_) {
+    problem.AddParameterBlock(f->p, 3);
+    problem.AddParameterBlock(f->q, 4, manifold);
+    problem.AddParameterBlock(f->v, 3);
+    problem.AddParameterBlock(f->bias, 6);
+  }
+  problem.AddParameterBlock(p_ic_, 3);
+  problem.AddParameterBlock(q_ic_, 4, manifold);
+  problem.AddParameterBlock(td_, 1);
+  if (!config_.estimate_extrinsic) {
+    problem.SetParameterBlockConstant(p_ic_);
+    problem.SetParameterBlockConstant(q_ic_);
+  }
+  if (!config_.estimate_time_offset) problem.SetParameterBlockConstant(td_);
+  if (prior_) problem.AddResidualBlock(prior_.get(), nullptr, prior_->blocks());
+  for (auto& item : r.items)
+    problem.AddResidualBlock(item.cost.get(), const_cast<ceres::LossFunction*>(item.loss), item.blocks);
+  for (double* d : r.fixed_depths) problem.SetParameterBlockConstant(d);
+  if (!prior_) {  // the first solve: hold the oldest pose (the gauge VINS-Mono fixes by re-anchoring afterwards)
+    problem.SetParameterBlockConstant(frames_.front()->p);
+    problem.SetParameterBlockConstant(frames_.front()->q);
+  }
+
+  ceres::Solver::Options options;
+  options.linear_solver_type = ceres::DENSE_SCHUR;
+  options.trust_region_strategy_type = ceres::DOGLEG;
+  options.max_num_iterations = config_.max_iterations;
+  options.num_threads = 1;
+  if (config_.max_solver_ms > 0 && !deterministic_) options.max_solver_time_in_seconds = config_.max_solver_ms * 1e-3;
+  ceres::Solver::Summary summary;
+  ceres::Solve(options, &problem, &summary);
+  result.iterations = static_cast<int>(summary.iterations.size());
+  solver_failed_ = summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost);
+  result.features = r.features;
+  result.with_lidar_depth = r.with_lidar_depth;
+
+  for (auto& [id, f] : features_.features())
+    if (r.inverse_depths.count(&f.inverse_depth)) f.depth = f.inverse_depth > 0 ? 1.0 / f.inverse_depth : -1.0;
+  fixGauge(T0_before);
+  features_.removeFailures();
+  share_three_ = r.features > 0 ? static_cast<double>(r.seen_three_times) / r.features : 0;
+  result.ms_solve = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+// VINS-Mono double2vector: the window is rotated about z and shifted so that the oldest frame keeps the yaw and
+// position it had before the solve (the 4 unobservable directions of visual-inertial odometry).
+void SlidingWindowEstimator::fixGauge(const Eigen::Isometry3d& T0_before) {
+  const Eigen::Isometry3d T0_after = frames_.front()->pose();
+  const double dyaw = yawOf(T0_before.linear()) - yawOf(T0_after.linear());
+  const Eigen::Matrix3d Rz = Eigen::AngleAxisd(dyaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  for (auto& f : frames_) {
+    Eigen::Isometry3d T = f->pose();
+    T.linear() = Rz * T.linear();
+    T.translation() = Rz * (T.translation() - T0_after.translation()) + T0_before.translation();
+    f->setPose(T);
+    f->setVelocity(Rz * f->velocity());
+  }
+}
+
+void SlidingWindowEstimator::removeOutliers(FrameResult& result) {
+  const std::vector<Eigen::Isometry3d> T_wc = cameraPoses();
+  const int newest = static_cast<int>(frames_.size()) - 1;
+  std::vector<std::pair<std::uint64_t, int>> drop;
+  for (const auto& [id, f] : features_.features()) {
+    if (!features_.usable(f, newest, config_.min_observations) || f.depth <= 0) continue;
+    const Observation& a = f.obs.front();
+    const Eigen::Vector2d na = a.normalized - (td_[0] - a.td) * a.velocity;
+    const Eigen::Vector3d p_w = T_wc[static_cast<std::size_t>(a.frame)] * (f.depth * na.homogeneous());
+    for (std::size_t k = 1; k < f.obs.size(); ++k) {
+      const Observation& o = f.obs[k];
+      const Eigen::Vector3d p_c = T_wc[static_cast<std::size_t>(o.frame)].inverse() * p_w;
+      const Eigen::Vector2d n = o.normalized - (td_[0] - o.td) * o.velocity;
+      const double err_px = p_c.z() > 0 ? focal_px_ * (p_c.hnormalized() - n).norm() : 1e9;
+      if (err_px > config_.outlier_px) drop.emplace_back(id, o.frame);
+    }
+  }
+  for (const auto& [id, frame] : drop) features_.removeObservation(id, frame);
+  result.outliers = static_cast<int>(drop.size());
+}
+
+}  // namespace drover::vio

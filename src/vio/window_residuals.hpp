@@ -1,0 +1,28 @@
+#pragma once
+// The residual blocks of the window (vio-internal): built once per solve, owned here so that the same cost
+// objects serve the solve and the marginalisation after it.
+#include <ceres/cost_function.h>
+#include <ceres/loss_function.h>
+
+#include <memory>
+#include <set>
+#include <vector>
+
+#include "vio/sliding_window.hpp"
+
+namespace drover::vio {
+
+struct SlidingWindowEstimator::Residuals {
+  struct Item {
+    std::unique_ptr<ceres::CostFunction> cost;
+    const ceres::LossFunction* loss = nullptr;
+    std::vector<double*> blocks;
+  };
+  std::vector<Item> items;
+  std::unique_ptr<ceres::LossFunction> robust;
+  std::set<double*> inverse_depths;     // every feature block used
+  std::set<double*> fixed_depths;       // depth_mode fixed: lidar-anchored features
+  int features = 0, with_lidar_depth = 0, seen_three_times = 0;  // features used; lidar-anchored; >= 3 frames
+};
+
+}  // namespace drover::vio

@@ -1,0 +1,126 @@
+// The sliding-window estimator on a synthetic scene with exact ground truth: seeded from the truth it tracks the
+// trajectory, finds the IMU biases and the camera time offset, and keeps doing so across marginalisations.
+#include <gtest/gtest.h>
+
+#include "vio/window_run.hpp"
+
+namespace drover::vio::test {
+namespace {
+
+imu::PreintegrationConfig imuConfig() { return {}; }
+
+VioConfig config() {
+  VioConfig c;
+  c.estimate_time_offset = false;
+  return c;
+}
+
+double positionError(const FrameResult& r, const WindowScene& scene) {
+  return (r.T_world_imu.translation() - scene.truth(toSeconds(r.t)).T_world_imu.translation()).norm();
+}
+
+double rotationErrorDeg(const FrameResult& r, const WindowScene& scene) {
+  const Eigen::Matrix3d dR = scene.truth(toSeconds(r.t)).T_world_imu.linear().transpose() * r.T_world_imu.linear();
+  return Eigen::AngleAxisd(dR).angle() * 180 / M_PI;
+}
+
+TEST(SlidingWindow, SeededFromTruthTracksTwentySecondsWithinFiveCentimetres) {
+  const WindowScene scene;
+  SlidingWindowEstimator est(config(), imuConfig(), scene.T_imu_cam, 460);
+  WindowRun run{scene};
+  const Seeder seed = truthSeeder(scene, Eigen::Vector3d(0.1, -0.1, 0.05));
+  double worst = 0, worst_rot = 0;
+  int estimated = 0;
+  FrameResult last;
+  for (double t = 0.05; t < 20; t += 1.0 / run.camera_hz) {
+    last = run.frame(est, t, seed);
+    ASSERT_FALSE(last.reset) << last.event;
+    if (!last.initialized) continue;
+    ++estimated;
+    worst = std::max(worst, positionError(last, scene));
+    worst_rot = std::max(worst_rot, rotationErrorDeg(last, scene));
+  }
+  EXPECT_GT(estimated, 250);
+  EXPECT_LT(worst, 0.05) << "m";
+  EXPECT_LT(worst_rot, 0.5) << "deg";
+  EXPECT_LT((last.bias.gyro - scene.gyro_bias).norm(), 1e-3);
+  EXPECT_LT((last.bias.acc - scene.acc_bias).norm(), 0.05);
+  EXPECT_LT((last.v_world - scene.truth(toSeconds(last.t)).v_world).norm(), 0.05);
+}
+
+TEST(SlidingWindow, KeepsTheWindowAtItsSizeAndSaysWhyItWaitsBeforeInitialisation) {
+  const WindowScene scene;
+  VioConfig c = config();
+  c.window = 5;
+  SlidingWindowEstimator est(c, imuConfig(), scene.T_imu_cam, 460);
+  WindowRun run{scene};
+  const FrameResult first = run.frame(est, 0.05, nullptr);
+  EXPECT_FALSE(first.initialized);
+  EXPECT_NE(first.event.find("window 1 of 6"), std::string::npos) << first.event;
+  for (int k = 1; k < 30; ++k) run.frame(est, 0.05 + k / 15.0, truthSeeder(scene));
+  EXPECT_EQ(est.windowSize(), 5);
+  EXPECT_TRUE(est.initialized());
+}
+
+TEST(SlidingWindow, EstimatesTheCameraTimeOffset) {
+  const WindowScene scene;
+  VioConfig c = config();
+  c.estimate_time_offset = true;
+  SlidingWindowEstimator est(c, imuConfig(), scene.T_imu_cam, 460);
+  WindowRun run{scene};
+  const double td = 0.008;  // [s] the camera stamps are 8 ms early: t_imu = t_camera + td
+  FrameResult last;
+  for (double t = 0.05; t < 15; t += 1.0 / run.camera_hz) {
+    last = run.frame(est, t, truthSeeder(scene), td);
+    ASSERT_FALSE(last.reset) << last.event;
+  }
+  EXPECT_NEAR(est.timeOffset(), td, 1e-3);
+  EXPECT_LT(positionError(last, scene), 0.05);
+}
+
+TEST(SlidingWindow, LidarDepthHeldFixedOrAsFactorKeepsTheEstimateOnTruth) {
+  const WindowScene scene;
+  for (DepthMode mode : {DepthMode::kFixed, DepthMode::kFactor}) {
+    VioConfig c = config();
+    c.depth_mode = mode;
+    SlidingWindowEstimator est(c, imuConfig(), scene.T_imu_cam, 460);
+    WindowRun run{scene};
+    run.edit = [&scene](double t, std::vector<FrameFeature>& fs) {  // exact depth for every other feature
+      const Eigen::Isometry3d T_cw = (scene.truth(t).T_world_imu * scene.T_imu_cam).inverse();
+      for (FrameFeature& f : fs)
+        if (f.id % 2 == 0) f.lidar_depth = (T_cw * scene.points[f.id]).z();
+    };
+    FrameResult last;
+    int with_depth = 0;
+    for (double t = 0.05; t < 10; t += 1.0 / run.camera_hz) {
+      last = run.frame(est, t, truthSeeder(scene));
+      ASSERT_FALSE(last.reset) << toString(mode) << ": " << last.event;
+      with_depth = std::max(with_depth, last.with_lidar_depth);
+    }
+    EXPECT_GT(with_depth, 20) << toString(mode);
+    EXPECT_LT(positionError(last, scene), 0.05) << toString(mode);
+  }
+}
+
+TEST(SlidingWindow, DropsObservationsThatAreOutliers) {
+  const WindowScene scene;
+  SlidingWindowEstimator est(config(), imuConfig(), scene.T_imu_cam, 460);
+  WindowRun run{scene};
+  int frame = 0;
+  run.edit = [&frame](double, std::vector<FrameFeature>& fs) {  // every 7th frame: 5 features moved by 20 px
+    if (++frame % 7 != 0) return;
+    for (std::size_t k = 0; k < fs.size() && k < 5; ++k) fs[k].normalized.x() += 20.0 / 460;
+  };
+  int outliers = 0;
+  FrameResult last;
+  for (double t = 0.05; t < 10; t += 1.0 / run.camera_hz) {
+    last = run.frame(est, t, truthSeeder(scene));
+    ASSERT_FALSE(last.reset) << last.event;
+    outliers += last.outliers;
+  }
+  EXPECT_GT(outliers, 10);
+  EXPECT_LT(positionError(last, scene), 0.05);
+}
+
+}  // namespace
+}  // namespace drover::vio::test
