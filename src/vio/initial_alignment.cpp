@@ -100,9 +100,23 @@ std::string AlignmentConfig::validate() const {
 }
 
 std::vector<imu::Preintegrator> preintegrateWindow(const std::vector<InitFrame>& frames, const imu::ImuBias& bias,
-                                                   const imu::PreintegrationConfig& imu_config) {
+                                                   const imu::PreintegrationConfig& imu_config, bool midpoint) {
   std::vector<ImuSample> samples = mergedSamples(frames);
   if (samples.empty()) throw std::invalid_argument("preintegrateWindow: no IMU sample in the window");
+  if (midpoint) {
+    // Mid-point rule (VINS-Mono IntegrationBase::midPointIntegration, here on the raw signals): the interval
+    // [t_k, t_k+1] gets (s_k + s_k+1) / 2, second-order accurate for samples of the instantaneous signal.
+    // The specific force at t_k+1 is turned into the IMU frame at t_k, so that the preintegrator's
+    // dR_ik f dt equals VINS-Mono's 1/2 (dR_ik a_k + dR_ik+1 a_k+1) dt.
+    for (std::size_t k = 0; k + 1 < samples.size(); ++k) {
+      const double dt = toSeconds(samples[k + 1].t - samples[k].t);
+      const Eigen::Vector3d w = 0.5 * (samples[k].omega_imu + samples[k + 1].omega_imu);
+      samples[k].omega_imu = w;
+      samples[k].acc_imu =
+          0.5 * (samples[k].acc_imu + geometry::expSO3((w - bias.gyro) * dt) * (samples[k + 1].acc_imu - bias.acc)) +
+          0.5 * bias.acc;
+    }
+  }
   // The first frame's samples are empty by contract: the first sample is held back to the first camera stamp.
   if (samples.front().t > frames.front().t) {
     ImuSample first = samples.front();
@@ -220,7 +234,7 @@ AlignmentResult alignVisualInertial(const std::vector<InitFrame>& frames, const 
 
   // (a) Excitation: the frame-to-frame average accelerations must vary (VINS-Mono initialStructure).
   imu::ImuBias bias;
-  std::vector<imu::Preintegrator> pre = preintegrateWindow(frames, bias, imu_config);
+  std::vector<imu::Preintegrator> pre = preintegrateWindow(frames, bias, imu_config, config.imu_midpoint);
   result.acc_excitation = accelerationExcitation(pre);
   if (result.acc_excitation < config.min_acc_excitation) {
     return refuse(result, "excitation: not enough motion, acceleration std " + fmt(result.acc_excitation, 3) +
@@ -245,7 +259,7 @@ AlignmentResult alignVisualInertial(const std::vector<InitFrame>& frames, const 
   // (d) Gyroscope bias, then the preintegrations again at the new bias.
   for (int it = 0; it < config.gyro_bias_iterations; ++it) {
     bias.gyro += solveGyroscopeBias(R_l_imu, pre);
-    pre = preintegrateWindow(frames, bias, imu_config);
+    pre = preintegrateWindow(frames, bias, imu_config, config.imu_midpoint);
   }
   result.gyro_bias = bias.gyro;
   if (!bias.gyro.allFinite()) return refuse(result, "gyro bias: not finite");

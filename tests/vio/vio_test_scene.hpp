@@ -3,10 +3,11 @@
 // roll/pitch/yaw), random 3-D points in front of a forward-looking camera, camera frames at 10 Hz and IMU samples
 // at 200 Hz with a known gyroscope bias and no noise.
 //
-// The IMU samples are the zero-order-hold equivalents of the analytic trajectory, so that Drover's preintegrator
-// (which holds each sample over its interval) reproduces the true motion: the rate is Log(R_k^T R_k+1) / dt and
-// the specific force R_k^T ((v_k+1 - v_k) / dt - g). Rotation and velocity deltas are then exact and the position
-// delta is the trapezoid rule of the true velocity (error ~1e-6 m over a frame interval).
+// The IMU samples are either the analytic body rate and specific force at their stamps (as a real IMU samples
+// them), or their zero-order-hold equivalents, with which Drover's preintegrator holding each sample over its
+// interval reproduces the true motion: the rate Log(R_k^T R_k+1) / dt and the specific force
+// R_k^T ((v_k+1 - v_k) / dt - g). Rotation and velocity deltas are then exact and the position delta is the
+// trapezoid rule of the true velocity (error ~1e-6 m over a frame interval).
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
@@ -31,6 +32,9 @@ struct SceneConfig {
   double pixel_noise_px = 0;  // std of the image noise at focal_px
   double focal_px = 460;
   unsigned seed = 7;
+  // true: zero-order-hold equivalents (exact under Drover's integration); false: the instantaneous analytic rate
+  // and specific force at each sample's stamp, as a real IMU samples them (integration error O(dt)).
+  bool hold_equivalent_samples = false;
 };
 
 struct Scene {
@@ -57,6 +61,17 @@ struct Trajectory {
 
   Eigen::Vector3d position(double t) const { return p0 + v0 * t + Eigen::Vector3d(px.value(t), py.value(t), pz.value(t)); }
   Eigen::Vector3d velocity(double t) const { return v0 + Eigen::Vector3d(px.rate(t), py.rate(t), pz.rate(t)); }
+  Eigen::Vector3d acceleration(double t) const { return Eigen::Vector3d(px.accel(t), py.accel(t), pz.accel(t)); }
+  // Body rate: vee(R^T dR/dt) with dR/dt from the Euler-angle rates (R = Rz(yaw) Ry(pitch) Rx(roll)).
+  Eigen::Vector3d bodyRate(double t) const {
+    const Eigen::Matrix3d Rz = Eigen::AngleAxisd(yaw0 + yaw.value(t), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3d Ry = Eigen::AngleAxisd(pitch.value(t), Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Matrix3d Rx = Eigen::AngleAxisd(roll.value(t), Eigen::Vector3d::UnitX()).toRotationMatrix();
+    const Eigen::Matrix3d dR = Rz * geometry::hat(Eigen::Vector3d::UnitZ()) * yaw.rate(t) * Ry * Rx +
+                               Rz * Ry * geometry::hat(Eigen::Vector3d::UnitY()) * pitch.rate(t) * Rx +
+                               Rz * Ry * Rx * geometry::hat(Eigen::Vector3d::UnitX()) * roll.rate(t);
+    return geometry::vee((Rz * Ry * Rx).transpose() * dR);
+  }
   Eigen::Matrix3d rotation(double t) const {
     return (Eigen::AngleAxisd(yaw0 + yaw.value(t), Eigen::Vector3d::UnitZ()) *
             Eigen::AngleAxisd(pitch.value(t), Eigen::Vector3d::UnitY()) *
@@ -146,8 +161,13 @@ inline Scene makeScene(const SceneConfig& config) {
         ImuSample s;
         s.t = ts;
         const Eigen::Matrix3d Ra = tr.rotation(a);
-        s.omega_imu = geometry::logSO3(Ra.transpose() * tr.rotation(b)) / dt + config.gyro_bias;
-        s.acc_imu = Ra.transpose() * ((tr.velocity(b) - tr.velocity(a)) / dt - g);
+        if (config.hold_equivalent_samples) {
+          s.omega_imu = geometry::logSO3(Ra.transpose() * tr.rotation(b)) / dt + config.gyro_bias;
+          s.acc_imu = Ra.transpose() * ((tr.velocity(b) - tr.velocity(a)) / dt - g);
+        } else {
+          s.omega_imu = tr.bodyRate(a) + config.gyro_bias;
+          s.acc_imu = Ra.transpose() * (tr.acceleration(a) - g);
+        }
         frame.imu.push_back(s);
       }
     }
