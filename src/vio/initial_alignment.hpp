@@ -11,6 +11,8 @@
 // excitation check refuses (VINS-Mono only prints); a rotation-only window is refused in the SfM.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
