@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -19,11 +20,13 @@ using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 
 int tangentSize(const MarginalBlock& b) { return b.manifold ? b.manifold->TangentSize() : b.ambient; }
 
-// M = D^-1 V S V^T D^-1 with D = diag(d), d_i = M_ii^-1/2 (1 where M_ii = 0): the eigen-decomposition of the
-// Jacobi-scaled D M D (unit diagonal), whose eigenvalues below eps * max are set to zero. Scaling first makes the
-// rank decision independent of units: a window's information spans ~1e10 (bias random walk) to ~1e1 (a weakly
-// seen velocity), and an unscaled relative threshold of 1e-8 would silently drop the latter; in the scaled matrix
-// only (near-)degenerate directions such as the gauge have tiny eigenvalues. Deterministic for a given input.
+// M = D^+ V S V^T D^+ with D = diag(d), d_i = M_ii^-1/2: the eigen-decomposition of the Jacobi-scaled D M D (unit
+// diagonal), whose eigenvalues below eps * max are set to zero. Scaling first makes the rank decision independent of
+// units: a window's information spans ~1e10 (bias random walk) to ~1e1 (a weakly seen velocity), and an unscaled
+// relative threshold of 1e-8 would silently drop the latter; in the scaled matrix only (near-)degenerate directions
+// such as the gauge have tiny eigenvalues. A coordinate whose diagonal is at the rounding level of the sums that
+// formed M (<= n u max_i M_ii) is not scaled up but left out (d_i = 0): its information is indistinguishable from
+// zero. Deterministic for a given input.
 struct ScaledEigen {
   VectorXd d;
   MatrixXd V;
@@ -33,7 +36,9 @@ struct ScaledEigen {
 
 ScaledEigen scaledEigen(const MatrixXd& M, double eps) {
   ScaledEigen out;
-  out.d = M.diagonal().unaryExpr([](double h) { return h > 0.0 ? 1.0 / std::sqrt(h) : 1.0; });
+  const double floor = static_cast<double>(M.rows()) * std::numeric_limits<double>::epsilon() *
+                       std::max(M.rows() > 0 ? M.diagonal().maxCoeff() : 0.0, 0.0);
+  out.d = M.diagonal().unaryExpr([floor](double h) { return h > floor ? 1.0 / std::sqrt(h) : 0.0; });
   if (M.rows() == 0) return out;
   const MatrixXd scaled = out.d.asDiagonal() * (0.5 * (M + M.transpose())) * out.d.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<MatrixXd> eig(scaled);
@@ -220,14 +225,15 @@ MarginalResult SchurMarginalizer::marginalize(const std::set<const double*>& dro
     b.noalias() -= H_km_DV * (s_inv.asDiagonal() * (e.V.transpose() * e.d.asDiagonal() * g.head(m)));
   }
 
-  // A = D^-1 V S V^T D^-1 -> L = sqrt(S) V^T D^-1, offset = sqrt(S)^+ V^T D b over the rank non-zero eigenvalues:
+  // A = D^+ V S V^T D^+ -> L = sqrt(S) V^T D^+, offset = sqrt(S)^+ V^T D b over the rank non-zero eigenvalues:
   // L^T L = A and L^T offset = b (b lies in A's range, being a Schur complement of a PSD H's gradient).
   const ScaledEigen e = scaledEigen(A, eps_);
   MarginalResult out;
   out.rank = e.rank;
   out.sqrt_information.resize(e.rank, k);
   out.offset.resize(e.rank);
-  const VectorXd d_inv = e.d.cwiseInverse(), d_b = e.d.cwiseProduct(b);
+  const VectorXd d_inv = e.d.unaryExpr([](double d) { return d > 0.0 ? 1.0 / d : 0.0; });
+  const VectorXd d_b = e.d.cwiseProduct(b);
   int row = 0;
   for (Eigen::Index j = 0; j < e.s.size(); ++j) {
     if (e.s(j) <= 0.0) continue;

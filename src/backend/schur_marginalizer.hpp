@@ -12,8 +12,9 @@
 //   r = sqrt(S)^+ V^T b + sqrt(S) V^T dx,   dx_k = Minus(x_k, x_lin_k),
 // which has gradient b and Hessian A at dx = 0. Both eigen-decompositions (H_mm for its pseudo-inverse, and A) are
 // of the Jacobi-scaled matrix D M D, D = diag(M)^-1/2, so that the rank cut does not depend on units (information
-// spans ~1e10 for a bias random walk to ~1e1 for a weakly seen velocity in one window); then A = D^-1 V S V^T D^-1
-// and L = sqrt(S) V^T D^-1, offset = sqrt(S)^+ V^T D b, which still satisfy L^T L = A and L^T offset = b.
+// spans ~1e10 for a bias random walk to ~1e1 for a weakly seen velocity in one window; a coordinate whose diagonal
+// is at rounding level, <= n u max diag, is left out); then A = D^+ V S V^T D^+ and L = sqrt(S) V^T D^+,
+// offset = sqrt(S)^+ V^T D b, which still satisfy L^T L = A and L^T offset = b.
 // The caller hands over exactly the residual blocks it then removes from the problem (in VINS-Mono: those touching
 // the dropped frame or its features, and the previous prior); a residual on kept blocks only is folded into the
 // prior as it is. Backend-internal header (ceres headers).

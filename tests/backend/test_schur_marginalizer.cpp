@@ -137,13 +137,14 @@ TEST(SchurMarginalizer, WeakButRealInformationSurvivesBesideInformationTenOrders
   // A gyro-bias-like block with information 1e10 and a velocity-like block with information 1 (1 m/s), coupled
   // through a dropped block: the rank cut is scale-free (Jacobi-scaled), so both directions stay. An unscaled
   // relative threshold of 1e-8 would drop the weak one.
-  std::vector<double> strong = {0.1}, weak = {0.2}, dropped = {0.3};
-  LinearCost on_strong({MatrixXd::Constant(1, 1, 1e5)}, VectorXd::Constant(1, 0.5));
+  // A third kept block with information 1e-22 of the largest is below the rounding level of H and is left out.
+  std::vector<double> strong = {0.1}, weak = {0.2}, dropped = {0.3}, noise = {0.4};
+  LinearCost on_strong({MatrixXd::Constant(1, 1, 1e5), MatrixXd::Constant(1, 1, 1e-6)}, VectorXd::Constant(1, 0.5));
   LinearCost link({MatrixXd::Constant(1, 1, 1.0), MatrixXd::Constant(1, 1, -1.0)}, VectorXd::Zero(1));
   LinearCost on_dropped({MatrixXd::Constant(1, 1, 1.0)}, VectorXd::Zero(1));
   SchurMarginalizer marg;
-  for (double* b : {strong.data(), weak.data(), dropped.data()}) marg.addBlock(b, 1, nullptr);
-  marg.addResidual(&on_strong, nullptr, {strong.data()});
+  for (double* b : {strong.data(), weak.data(), dropped.data(), noise.data()}) marg.addBlock(b, 1, nullptr);
+  marg.addResidual(&on_strong, nullptr, {strong.data(), noise.data()});
   marg.addResidual(&link, nullptr, {weak.data(), dropped.data()});
   marg.addResidual(&on_dropped, nullptr, {dropped.data()});
   const MarginalResult m = marg.marginalize({dropped.data()});
@@ -154,6 +155,8 @@ TEST(SchurMarginalizer, WeakButRealInformationSurvivesBesideInformationTenOrders
   EXPECT_NEAR(A(0, 0), 1e10, 1e-6 * 1e10);
   EXPECT_NEAR(A(1, 1), 0.5, 1e-9);
   EXPECT_NEAR(A(0, 1), 0.0, 1e-9);
+  EXPECT_EQ(A.row(2).norm(), 0.0);
+  EXPECT_TRUE(m.sqrt_information.allFinite() && m.offset.allFinite());
 }
 
 TEST(SchurMarginalizer, PriorFactorResidualIsTheOffsetAtTheLinearisationPointAndItsJacobiansAreNumerical) {
