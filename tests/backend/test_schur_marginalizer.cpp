@@ -269,6 +269,34 @@ TEST(SchurMarginalizer, RobustLossesAreAppliedAsCeresAppliesThem) {
   EXPECT_GT(scaledError(informationOf(plain), H), 1e-2);
 }
 
+TEST(SchurMarginalizer, MarginalisingTwiceThroughThePriorFactorEqualsMarginalisingOnce) {
+  // The sliding-window pattern: the previous prior is one of the residuals of the next marginalisation.
+  // prior(x0) - (x0, x1) - (x1, x2): dropping x0, then x1 (with the first prior) equals dropping {x0, x1} at once.
+  std::mt19937 rng(11);
+  LinearProblem p;
+  for (int i = 0; i < 3; ++i) p.addBlock(randomVec(rng, 3));
+  p.addCost(rng, 3, {0});
+  p.addCost(rng, 4, {0, 1});
+  p.addCost(rng, 4, {1, 2});
+  SchurMarginalizer once = p.marginalizer();
+  const MarginalResult direct = once.marginalize({p.x[0].data(), p.x[1].data()});
+  SchurMarginalizer first;
+  for (int b : {0, 1}) first.addBlock(p.x[b].data(), 3, nullptr);
+  first.addResidual(p.costs[0].get(), nullptr, {p.x[0].data()});
+  first.addResidual(p.costs[1].get(), nullptr, {p.x[0].data(), p.x[1].data()});
+  const MarginalPriorFactor prior1(first.marginalize({p.x[0].data()}));
+  SchurMarginalizer second;
+  for (int b : {1, 2}) second.addBlock(p.x[b].data(), 3, nullptr);
+  second.addResidual(&prior1, nullptr, prior1.blocks());
+  second.addResidual(p.costs[2].get(), nullptr, {p.x[1].data(), p.x[2].data()});
+  const MarginalResult chained = second.marginalize({p.x[1].data()});
+  ASSERT_TRUE(direct.ok && chained.ok) << direct.reason << chained.reason;
+  ASSERT_EQ(chained.kept, direct.kept);
+  EXPECT_LT(relativeError(informationOf(chained), informationOf(direct)), 1e-10);
+  EXPECT_LT(relativeError(gradientOf(chained), gradientOf(direct)), 1e-10);
+  expectExactMarginal(p, {2}, chained, 1e-10);
+}
+
 namespace {
 class FailingCost final : public ceres::SizedCostFunction<1, 2> {
  public:
