@@ -11,7 +11,7 @@ namespace fs = std::filesystem;
 // Every file drover run writes into its folder (run_output.hpp; keep in step with it), and the report that
 // tools/course_report.py adds to it (scripts/run.sh), which describes the run it replaces.
 constexpr const char* kRunFiles[] = {"trajectory.tum", "trajectory_kitti.txt", "keyframes.tum",
-                                     "trajectory_imu_rate.tum", "map.pcd", "map.ply", "report.json", "ape.json",
+                                     "trajectory_imu_rate.tum", "trajectory_vis.tum", "map.pcd", "map.ply", "report.json", "ape.json",
                                      "ape.png", "course_report.json"};
 
 bool isRunFile(const std::string& name) {
@@ -24,7 +24,7 @@ bool isRunFile(const std::string& name) {
 bool isRunReport(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return j.is_object() && j.contains("counts") && j.contains("scans");
+  return j.is_object() && j.contains("counts") && (j.contains("scans") || j.contains("vis"));
 }
 
 std::atomic<int> g_signal{0};

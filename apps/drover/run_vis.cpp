@@ -35,7 +35,8 @@ std::optional<Eigen::Isometry3d> lisPoseAt(const Trajectory& imu_rate, Time t) {
   return T;
 }
 
-constexpr std::size_t kMaxEvents = 200;  // report.json keeps the first events; the counters count them all
+constexpr std::size_t kMaxEvents = 200;
+constexpr std::size_t kLisStartSweeps = 20;  // sweeps the LIS gets to initialise its IMU before the VIS stops waiting  // report.json keeps the first events; the counters count them all
 
 }  // namespace
 
@@ -85,7 +86,11 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   vio::Seeder seed;
   if (lis != nullptr) {
     pose_at = [lis](Time t) { return lisPoseAt(lis->imuRateTrajectory(), t); };
-    seed = [this, lis](Time t) { return seedAt(t, *lis); };
+    // The VIS waits for the LIS to seed it while the LIS can: it fuses the IMU, or is still starting (its first
+    // sweeps). An LIS that gave the IMU up (lidar only) cannot seed: the VIS then aligns visually.
+    const pipeline::OdometryStats& s = lis->stats();
+    const bool lis_can_seed = lis->config().use_imu && (s.imu_initialized || s.scans_processed < kLisStartSweeps);
+    if (lis_can_seed) seed = [this, lis](Time t) { return seedAt(t, *lis); };
   }
   vio::VisFrame f;
   try {

@@ -80,8 +80,12 @@ double ReprojectionFactor::cheirality(double const* const* parameters) const {
 
 bool ReprojectionFactor::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
   const Chain c = transformChain(parameters, obs_i_, velocity_i_, td_i_);
-  // !(x > t) also rejects NaN.
-  if (!(c.lambda > 0) || !(c.P_cj.z() > kMinDepth) || !c.P_cj.allFinite() || !std::isfinite(c.td)) return false;
+  // Only a singular projection fails (Ceres then rejects the whole step). A point behind a camera, or a negative
+  // inverse depth, gives a large finite residual that the robust loss bounds, as in VINS-Mono: with hundreds of
+  // features in a forward-moving window some far, low-parallax feature flips sign in nearly every trial step, and
+  // failing on it would freeze the solve. The estimator drops such features after the solve. !(x > t) rejects NaN.
+  if (!(std::abs(c.lambda) > 0) || !(std::abs(c.P_cj.z()) > kMinDepth) || !c.P_cj.allFinite() || !std::isfinite(c.td))
+    return false;
 
   const double s = sqrt_information_;
   const double inv_z = 1.0 / c.P_cj.z();

@@ -28,8 +28,8 @@ class ReprojectionFactor final : public ceres::SizedCostFunction<2, 3, 4, 3, 4, 
   ReprojectionFactor(const Eigen::Vector2d& obs_i, const Eigen::Vector2d& obs_j, const Eigen::Vector2d& velocity_i,
                      const Eigen::Vector2d& velocity_j, double td_i, double td_j, double sqrt_information);
 
-  // False (Ceres rejects the step) when lambda <= 0 or P_cj.z <= 1e-9 m (the point is behind either camera) or a
-  // value is not finite.
+  // False (Ceres rejects the step) only when lambda = 0, |P_cj.z| <= 1e-9 m or a value is not finite. A point
+  // behind a camera (lambda < 0 or P_cj.z < 0) evaluates to a large finite residual, as in VINS-Mono.
   bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
 
   // P_cj.z [m], the feature's depth in the observing camera j at these parameters (> 0: in front).

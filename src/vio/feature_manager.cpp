@@ -44,6 +44,9 @@ bool FeatureManager::usable(const Feature& f, int newest, int min_obs) const {
 
 namespace {
 
+constexpr double kMinDepth = 0.1;    // [m]
+constexpr double kMaxDepth = 200.0;  // [m]
+
 Eigen::Vector3d bearing(const Observation& o) { return {o.normalized.x(), o.normalized.y(), 1.0}; }
 
 // Linear triangulation (DLT, Hartley & Zisserman Sec. 12.2) of a point in the anchor camera from all observations:
@@ -78,7 +81,9 @@ void FeatureManager::initializeDepths(const std::vector<Eigen::Isometry3d>& T_wo
     }
     if (f.depth > 0) continue;
     const double d = triangulateDepth(f, T_world_cam);
-    f.depth = d > 0.1 ? d : 0;  // VINS-Mono: a depth below 0.1 m becomes the initial guess; here it waits
+    // VINS-Mono puts a depth below 0.1 m at its initial guess; here such a feature, or one too far for its baseline
+    // to tell (a forward-moving camera's focus of expansion), waits for more parallax.
+    f.depth = d > kMinDepth && d < kMaxDepth ? d : 0;
   }
 }
 

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -23,7 +25,7 @@ SlidingWindowEstimator::SlidingWindowEstimator(const VioConfig& config, const im
   if (!(focal_px > 0) || !std::isfinite(focal_px)) throw std::invalid_argument("vio: focal length must be > 0");
   const Eigen::Quaterniond q(T_imu_cam.rotation());
   q_ic_[0] = q.x(), q_ic_[1] = q.y(), q_ic_[2] = q.z(), q_ic_[3] = q.w();
-  Eigen::Map<Eigen::Vector3d>(p_ic_) = T_imu_cam.translation();
+  Eigen::Map<Eigen::Vector3d>{p_ic_} = T_imu_cam.translation();
 }
 
 SlidingWindowEstimator::~SlidingWindowEstimator() = default;
@@ -39,8 +41,19 @@ Time SlidingWindowEstimator::imuTime(Time t_camera) const {
   return t_camera + static_cast<Time>(std::llround(td_[0] * 1e9));
 }
 
+// The preintegration holds each sample until the next one (zero-order hold). With config.imu_midpoint the held
+// value is the mean of the sample and the next one, which makes the integration VINS-Mono's mid-point rule (second
+// order): at 200 Hz and 1.5 rad/s^2 the hold alone lags the attitude by half a sample, which the window would
+// otherwise absorb as ~4e-3 rad/s of gyro bias.
 void SlidingWindowEstimator::addImu(const ImuSample& sample) {
   if (!imu_.empty() && sample.t <= imu_.back().t) return;  // the caller checks order; never integrate backwards
+  if (config_.imu_midpoint && !imu_.empty()) {
+    ImuSample& previous = imu_.back();
+    previous.omega_imu = 0.5 * (raw_newest_omega_ + sample.omega_imu);
+    previous.acc_imu = 0.5 * (raw_newest_acc_ + sample.acc_imu);
+  }
+  raw_newest_omega_ = sample.omega_imu;
+  raw_newest_acc_ = sample.acc_imu;
   imu_.push_back(sample);
 }
 
@@ -95,6 +108,7 @@ std::vector<Eigen::Isometry3d> SlidingWindowEstimator::cameraPoses() const {
 }
 
 void SlidingWindowEstimator::reset() {
+  init_prior_.active = false;
   frames_.clear();
   features_.clear();
   prior_.reset();
@@ -128,6 +142,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
   const int index = static_cast<int>(frames_.size());
   const double parallax = features_.addFrame(index, features, td_[0]);
   result.tracked = features_.lastTracked();
+  if (std::getenv("VIO_DEBUG")) std::fprintf(stderr, "frame %d parallax %.2f px tracked %d\n", index, parallax * config_.focal_px, features_.lastTracked());
   const bool keyframe = index < 2 || parallax < 0 || result.tracked < config_.min_tracked_for_parallax ||
                         parallax * config_.focal_px >= config_.min_parallax_px;
   if (!frames_.empty()) {
@@ -138,7 +153,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
 
   if (!initialized_) {
     if (!tryInitialize(seed, result)) {
-      if (static_cast<int>(frames_.size()) > config_.window) slide(keyframe, result);
+      if (static_cast<int>(frames_.size()) > config_.window) slide(keyframe || waiting_for_older_, result);
       return result;
     }
   }
@@ -166,10 +181,12 @@ bool SlidingWindowEstimator::tryInitialize(const Seeder& seed, FrameResult& resu
   }
   std::string why;
   bool ok = false;
-  const bool seed_ready = seed && seed(frames_.front()->t) && seed(frames_.back()->t);
-  if (config_.init == InitMode::kLis || (config_.init == InitMode::kAuto && seed_ready)) {
+  // LVI-SAM: while the LIS runs, the VIS starts from its state; the window waits until the LIS covers it.
+  if (config_.init == InitMode::kLis || (config_.init == InitMode::kAuto && seed)) {
     ok = initializeFromSeed(seed, why);
     if (ok) result.event = "initialised from the LIS";
+    // Frames older than the LIS's first state can never be seeded: let the oldest go.
+    waiting_for_older_ = !ok && seed && !seed(frames_.front()->t) && seed(frames_.back()->t);
   } else {
     ok = initializeVisually(why);
     if (ok) result.event = "initialised by visual-inertial alignment: " + why;
@@ -181,6 +198,19 @@ bool SlidingWindowEstimator::tryInitialize(const Seeder& seed, FrameResult& resu
   initialized_ = true;
   result.just_initialized = true;
   return true;
+}
+
+void SlidingWindowEstimator::setInitPrior(double sigma_rotation, double sigma_velocity, double sigma_gyro_bias,
+                                          double sigma_acc_bias) {
+  init_prior_.active = true;
+  const Frame& f = *frames_.front();
+  std::copy(f.p, f.p + 3, init_prior_.p);
+  std::copy(f.q, f.q + 4, init_prior_.q);
+  std::copy(f.v, f.v + 3, init_prior_.v);
+  std::copy(f.bias, f.bias + 6, init_prior_.bias);
+  init_prior_.sigma << Eigen::Vector3d::Constant(config_.init_sigma_position_m), Eigen::Vector3d::Constant(sigma_rotation),
+      Eigen::Vector3d::Constant(sigma_velocity), Eigen::Vector3d::Constant(sigma_gyro_bias),
+      Eigen::Vector3d::Constant(sigma_acc_bias);
 }
 
 bool SlidingWindowEstimator::initializeFromSeed(const Seeder& seed, std::string& why) {
@@ -204,6 +234,9 @@ bool SlidingWindowEstimator::initializeFromSeed(const Seeder& seed, std::string&
     if (k > 0) integrate(*frames_[k], *frames_[k - 1]);
   }
   features_.initializeDepths(cameraPoses(), config_.depth_mode != DepthMode::kOff);
+  // The LIS's attitude is gravity-aligned by its own smoother and its biases are fused over many sweeps.
+  setInitPrior(config_.lis_sigma_rotation_rad, config_.lis_sigma_velocity, config_.lis_sigma_gyro_bias,
+               config_.lis_sigma_acc_bias);
   return true;
 }
 

@@ -29,7 +29,8 @@ class MarginalPriorFactor;
 
 namespace drover::vio {
 
-// An externally known state at a camera stamp (the LIS's IMU-rate state).
+// An externally known state at a camera stamp (the LIS's IMU-rate state). A Seeder is given while the LIS runs
+// (even before it can answer): initialisation then waits for it instead of aligning visually.
 struct SeedState {
   Eigen::Isometry3d T_world_imu = Eigen::Isometry3d::Identity();
   Eigen::Vector3d v_world = Eigen::Vector3d::Zero();  // [m/s]
@@ -110,12 +111,24 @@ class SlidingWindowEstimator {
   std::deque<std::unique_ptr<Frame>> frames_;  // stable addresses: the marginal prior points into them
   FeatureManager features_;
   std::deque<ImuSample> imu_;
+  Eigen::Vector3d raw_newest_omega_ = Eigen::Vector3d::Zero(), raw_newest_acc_ = Eigen::Vector3d::Zero();
   std::unique_ptr<backend::MarginalPriorFactor> prior_;
   bool initialized_ = false;
   std::optional<FrameResult> last_output_;
   double share_three_ = 0;
   bool deterministic_ = true;
   bool solver_failed_ = false;
+  bool waiting_for_older_ = false;  // initialisation waits for a seed the oldest frame predates
+  // The initialisation's knowledge of the oldest frame (pose, velocity, biases) as a prior with these sigmas
+  // (tangent order p, theta, v, b_g, b_a); it holds the gauge and the tilt / accelerometer-bias ambiguity of a
+  // straight drive until the first marginalisation folds it into the marginal prior.
+  struct InitPrior {
+    bool active = false;
+    Eigen::Matrix<double, 15, 1> sigma = Eigen::Matrix<double, 15, 1>::Ones();
+    double p[3], q[4], v[3], bias[6];  // the oldest frame's state at initialisation
+  };
+  InitPrior init_prior_;
+  void setInitPrior(double sigma_rotation, double sigma_velocity, double sigma_gyro_bias, double sigma_acc_bias);
 };
 
 }  // namespace drover::vio

@@ -49,7 +49,12 @@ std::string VioConfig::validate() const {
   if (max_iterations < 1) return "max_iterations must be >= 1";
   if (!nonNegative(max_solver_ms)) return "max_solver_ms must be >= 0";
   if (!positive(max_time_offset_s)) return "max_time_offset_s must be > 0";
+  if (!positive(time_offset_sigma_s)) return "time_offset_sigma_s must be > 0";
   if (!positive(init_min_parallax_px)) return "init_min_parallax_px must be > 0";
+  for (double sigma : {init_sigma_position_m, lis_sigma_rotation_rad, lis_sigma_velocity, lis_sigma_gyro_bias,
+                       lis_sigma_acc_bias, align_sigma_rotation_rad, align_sigma_velocity, align_sigma_gyro_bias,
+                       align_sigma_acc_bias})
+    if (!positive(sigma)) return "the initialisation sigmas (init_sigma_*, lis_sigma_*, align_sigma_*) must be > 0";
   if (!nonNegative(init_min_acc_excitation)) return "init_min_acc_excitation must be >= 0";
   if (min_tracked < 0) return "min_tracked must be >= 0";
   if (!positive(max_imu_gap_s)) return "max_imu_gap_s must be > 0";

@@ -39,8 +39,20 @@ struct VioConfig {
   double max_solver_ms = 40;       // [ms] solver time limit per frame; only in live use (replay is deterministic)
   bool estimate_extrinsic = false; // refine T_imu_cam online (VINS ESTIMATE_EXTRINSIC 1)
   bool estimate_time_offset = true;  // estimate the camera-IMU time offset td (VINS ESTIMATE_TD)
+  double time_offset_sigma_s = 0.005;  // [s] prior on td around the calibration's offset
   double max_time_offset_s = 0.05; // [s] |td| above this is a failure
+  bool imu_midpoint = true;         // integrate the IMU by the mid-point rule (VINS-Mono) instead of holding samples
   InitMode init = InitMode::kAuto;
+  // The prior on the oldest frame at initialisation (sigmas): from the LIS, and from visual-inertial alignment.
+  double init_sigma_position_m = 0.01;   // [m] (holds the gauge)
+  double lis_sigma_rotation_rad = 0.01;  // [rad]
+  double lis_sigma_velocity = 0.1;       // [m/s]
+  double lis_sigma_gyro_bias = 0.005;    // [rad/s]
+  double lis_sigma_acc_bias = 0.1;       // [m/s^2]
+  double align_sigma_rotation_rad = 0.03;  // [rad]
+  double align_sigma_velocity = 0.2;       // [m/s]
+  double align_sigma_gyro_bias = 0.01;     // [rad/s]
+  double align_sigma_acc_bias = 0.3;       // [m/s^2]
   // Visual-inertial alignment (no lidar): VINS-Mono's thresholds.
   double init_min_parallax_px = 30;     // [px at focal_px] relative-pose pair
   double init_min_acc_excitation = 0.25;  // [m/s^2] std of the window's average accelerations

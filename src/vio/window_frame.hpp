@@ -30,10 +30,10 @@ struct SlidingWindowEstimator::Frame {
   void setPose(const Eigen::Isometry3d& T) {
     const Eigen::Quaterniond r(T.rotation());
     q[0] = r.x(), q[1] = r.y(), q[2] = r.z(), q[3] = r.w();
-    Eigen::Map<Eigen::Vector3d>(p) = T.translation();
+    Eigen::Map<Eigen::Vector3d>{p} = T.translation();
   }
   Eigen::Vector3d velocity() const { return Eigen::Vector3d(v[0], v[1], v[2]); }
-  void setVelocity(const Eigen::Vector3d& vel) { Eigen::Map<Eigen::Vector3d>(v) = vel; }
+  void setVelocity(const Eigen::Vector3d& vel) { Eigen::Map<Eigen::Vector3d>{v} = vel; }
   imu::ImuBias imuBias() const {
     imu::ImuBias b;
     b.gyro = Eigen::Vector3d(bias[0], bias[1], bias[2]);
@@ -41,8 +41,8 @@ struct SlidingWindowEstimator::Frame {
     return b;
   }
   void setBias(const imu::ImuBias& b) {
-    Eigen::Map<Eigen::Vector3d>(bias) = b.gyro;
-    Eigen::Map<Eigen::Vector3d>(bias + 3) = b.acc;
+    Eigen::Map<Eigen::Vector3d>{bias} = b.gyro;
+    Eigen::Map<Eigen::Vector3d>{bias + 3} = b.acc;
   }
 };
 

@@ -35,6 +35,10 @@ bool SlidingWindowEstimator::initializeVisually(std::string& why) {
     f.depth = z > 0.1 ? z : 0;
   }
   features_.initializeDepths(T_wc, config_.depth_mode != DepthMode::kOff);
+  // The alignment's gravity and gyro bias are good to about a degree and 1e-3 rad/s on real data; it does not
+  // estimate the accelerometer bias (zero, as VINS-Mono).
+  setInitPrior(config_.align_sigma_rotation_rad, config_.align_sigma_velocity, config_.align_sigma_gyro_bias,
+               config_.align_sigma_acc_bias);
   why = fmt::format("scale {:.3f}, gyro bias ({:.4f}, {:.4f}, {:.4f}) rad/s", a.scale, a.gyro_bias.x(),
                     a.gyro_bias.y(), a.gyro_bias.z());
   return true;

@@ -60,6 +60,7 @@ void SlidingWindowEstimator::marginalizeOldest() {
   std::set<const double*> drop{P[0], Q[0], V[0], B[0]};
   for (double* d : r.inverse_depths) drop.insert(d);
   backend::MarginalResult result = m.marginalize(drop);
+  init_prior_.active = false;  // buildResiduals put it in r: it now lives on in the marginal prior
   if (result.ok) prior_ = std::make_unique<backend::MarginalPriorFactor>(std::move(result));
   else prior_.reset();  // the window then floats on its IMU and features until the next marginalisation
 }

@@ -1,14 +1,18 @@
 // The window's nonlinear least squares (VINS-Mono Sec. VI, Eq. 22): marginal prior, IMU preintegration and bias
 // random walk, robust reprojection of every usable feature, and LVI-SAM's lidar depth; then outliers and gauge.
 #include <ceres/ceres.h>
+#include <glog/logging.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include "backend/imu_factors.hpp"
 #include "backend/quaternion_manifold.hpp"
 #include "backend/schur_marginalizer.hpp"
+#include "backend/state_prior_factor.hpp"
 #include "backend/visual_factors.hpp"
 #include "vio/window_frame.hpp"
 #include "vio/window_residuals.hpp"
@@ -19,26 +23,63 @@ namespace {
 // VINS-Mono repropagates a preintegration when the bias moved this far from its linearisation point.
 constexpr double kRepropagateAcc = 0.10;   // [m/s^2]
 constexpr double kRepropagateGyro = 0.01;  // [rad/s]
+constexpr double kMinDepth = 0.05;         // [m] in the observing camera for a reprojection factor to be added
 
 double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
+
+// Ceres reports a rejected trial step through glog at WARNING level, once per step: a normal event in a
+// trust-region solve that would flood a run's terminal. Errors still print.
+void quietSolverWarnings() {
+  static const bool once = [] {
+    FLAGS_minloglevel = std::max(FLAGS_minloglevel, 2);  // google::GLOG_ERROR
+    return true;
+  }();
+  (void)once;
+}
 
 const backend::RightQuaternionManifold& quaternionManifold() {
   static const backend::RightQuaternionManifold manifold;
   return manifold;
 }
 
+// A Gaussian prior on the time offset td [s] around zero (the calibration's value): td is nearly unobservable
+// while the window barely moves (a time shift then looks like a position shift of v td), and without a prior the
+// first solves after initialisation can throw it tens of milliseconds off.
+class TimeOffsetPrior final : public ceres::SizedCostFunction<1, 1> {
+ public:
+  explicit TimeOffsetPrior(double sigma_s) : weight_(1.0 / sigma_s) {}
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    residuals[0] = weight_ * parameters[0][0];
+    if (jacobians != nullptr && jacobians[0] != nullptr) jacobians[0][0] = weight_;
+    return true;
+  }
+
+ private:
+  double weight_;
+};
+
 }  // namespace
 
 void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) const {
   r.robust = std::make_unique<ceres::CauchyLoss>(config_.robust_px / config_.sigma_px);
   const std::size_t n = frames_.size();
+  if (init_prior_.active) {
+    backend::StatePoint at;
+    at.p_world = Eigen::Vector3d(init_prior_.p[0], init_prior_.p[1], init_prior_.p[2]);
+    at.q_world_imu = Eigen::Quaterniond(init_prior_.q[3], init_prior_.q[0], init_prior_.q[1], init_prior_.q[2]);
+    at.v_world = Eigen::Vector3d(init_prior_.v[0], init_prior_.v[1], init_prior_.v[2]);
+    at.bias = Eigen::Map<const backend::Vector6d>(init_prior_.bias);
+    const backend::Matrix15d L = init_prior_.sigma.cwiseInverse().asDiagonal();
+    Frame& f = *frames_.front();
+    r.items.push_back({std::make_unique<backend::NavStatePriorFactor>(at, L), nullptr, {f.p, f.q, f.v, f.bias}});
+  }
   for (std::size_t k = 1; k < n; ++k) {
     if (oldest_only && k > 1) break;
     Frame& a = *frames_[k - 1];
     Frame& b = *frames_[k];
     if (!b.pre || b.pre->deltaTime() <= 0) continue;
     r.items.push_back({std::make_unique<backend::ImuPreintegrationFactor>(*b.pre), nullptr,
-                       {a.p, a.q, a.v, a.bias, b.p, b.q, b.v, b.bias}});
+                       {a.p, a.q, a.v, a.bias, b.p, b.q, b.v}});
     r.items.push_back({std::make_unique<backend::BiasRandomWalkFactor>(imu_config_.gyro_bias_random_walk,
                                                                        imu_config_.acc_bias_random_walk,
                                                                        b.pre->deltaTime()),
@@ -52,6 +93,8 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
       used.push_back(&f);
   std::stable_sort(used.begin(), used.end(), [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
   if (static_cast<int>(used.size()) > config_.max_features) used.resize(static_cast<std::size_t>(config_.max_features));
+  if (!oldest_only && config_.estimate_time_offset)
+    r.items.push_back({std::make_unique<TimeOffsetPrior>(config_.time_offset_sigma_s), nullptr, {const_cast<double*>(td_)}});
   const double sqrt_info = focal_px_ / config_.sigma_px;
   double* p_ic = const_cast<double*>(p_ic_);
   double* q_ic = const_cast<double*>(q_ic_);
@@ -66,9 +109,12 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
     for (std::size_t k = 1; k < f->obs.size(); ++k) {
       const Observation& oj = f->obs[k];
       Frame& fj = *frames_[static_cast<std::size_t>(oj.frame)];
-      r.items.push_back({std::make_unique<backend::ReprojectionFactor>(oi.normalized, oj.normalized, oi.velocity,
-                                                                       oj.velocity, oi.td, oj.td, sqrt_info),
-                         r.robust.get(), {fi.p, fi.q, fj.p, fj.q, p_ic, q_ic, &f->inverse_depth, td}});
+      auto cost = std::make_unique<backend::ReprojectionFactor>(oi.normalized, oj.normalized, oi.velocity,
+                                                                oj.velocity, oi.td, oj.td, sqrt_info);
+      std::vector<double*> blocks{fi.p, fi.q, fj.p, fj.q, p_ic, q_ic, &f->inverse_depth, td};
+      // A point behind the observing camera at the start would fail the whole solve: that observation waits.
+      if (!(cost->cheirality(blocks.data()) > kMinDepth)) continue;
+      r.items.push_back({std::move(cost), r.robust.get(), std::move(blocks)});
     }
     if (!f->lidar_anchor) continue;
     ++r.with_lidar_depth;
@@ -84,6 +130,7 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
 }
 
 void SlidingWindowEstimator::optimize(FrameResult& result) {
+  quietSolverWarnings();
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t k = 1; k < frames_.size(); ++k) {  // relinearise preintegrations whose bias moved far
     const imu::ImuBias now = frames_[k - 1]->imuBias();
@@ -119,20 +166,35 @@ void SlidingWindowEstimator::optimize(FrameResult& result) {
   if (prior_) problem.AddResidualBlock(prior_.get(), nullptr, prior_->blocks());
   for (auto& item : r.items)
     problem.AddResidualBlock(item.cost.get(), const_cast<ceres::LossFunction*>(item.loss), item.blocks);
-  for (double* d : r.fixed_depths) problem.SetParameterBlockConstant(d);
-  if (!prior_) {  // the first solve: hold the oldest pose (the gauge VINS-Mono fixes by re-anchoring afterwards)
+  for (double* d : r.fixed_depths)
+    if (problem.HasParameterBlock(d)) problem.SetParameterBlockConstant(d);
+  if (!prior_ && !init_prior_.active) {  // no prior holds the gauge: hold the oldest pose
     problem.SetParameterBlockConstant(frames_.front()->p);
     problem.SetParameterBlockConstant(frames_.front()->q);
   }
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
+  if (const char* ls = std::getenv("VIO_LS")) {
+    if (std::string(ls) == "sparse_schur") options.linear_solver_type = ceres::SPARSE_SCHUR;
+    if (std::string(ls) == "snc") options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+    if (std::string(ls) == "lm") options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  }
   options.trust_region_strategy_type = ceres::DOGLEG;
   options.max_num_iterations = config_.max_iterations;
   options.num_threads = 1;
   if (config_.max_solver_ms > 0 && !deterministic_) options.max_solver_time_in_seconds = config_.max_solver_ms * 1e-3;
   ceres::Solver::Summary summary;
+  const auto t_build = std::chrono::steady_clock::now();
   ceres::Solve(options, &problem, &summary);
+  if (std::getenv("VIO_PROFILE"))
+    std::fprintf(stderr, "td %.5f feats %d items %zu iters %zu cost %.3g->%.3g build %.2f pre %.2f min %.2f lin %.2f res %.2f jac %.2f post %.2f total %.2f\n",
+                 td_[0], r.features, r.items.size(), summary.iterations.size(), summary.initial_cost, summary.final_cost,
+                 std::chrono::duration<double, std::milli>(t_build - start).count(),
+                 summary.preprocessor_time_in_seconds * 1e3, summary.minimizer_time_in_seconds * 1e3,
+                 summary.linear_solver_time_in_seconds * 1e3, summary.residual_evaluation_time_in_seconds * 1e3,
+                 summary.jacobian_evaluation_time_in_seconds * 1e3, summary.postprocessor_time_in_seconds * 1e3,
+                 summary.total_time_in_seconds * 1e3);
   result.iterations = static_cast<int>(summary.iterations.size());
   solver_failed_ = summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost);
   result.features = r.features;

@@ -9,9 +9,10 @@ namespace {
 
 imu::PreintegrationConfig imuConfig() { return {}; }
 
-VioConfig config() {
+VioConfig config() {  // 80 features keep each test within a few seconds
   VioConfig c;
   c.estimate_time_offset = false;
+  c.max_features = 80;
   return c;
 }
 
@@ -24,7 +25,7 @@ double rotationErrorDeg(const FrameResult& r, const WindowScene& scene) {
   return Eigen::AngleAxisd(dR).angle() * 180 / M_PI;
 }
 
-TEST(SlidingWindow, SeededFromTruthTracksTwentySecondsWithinFiveCentimetres) {
+TEST(SlidingWindow, SeededFromTruthTracksTwelveSecondsWithinTwoCentimetresAndFindsTheBiases) {
   const WindowScene scene;
   SlidingWindowEstimator est(config(), imuConfig(), scene.T_imu_cam, 460);
   WindowRun run{scene};
@@ -32,7 +33,7 @@ TEST(SlidingWindow, SeededFromTruthTracksTwentySecondsWithinFiveCentimetres) {
   double worst = 0, worst_rot = 0;
   int estimated = 0;
   FrameResult last;
-  for (double t = 0.05; t < 20; t += 1.0 / run.camera_hz) {
+  for (double t = 0.05; t < 12; t += 1.0 / run.camera_hz) {
     last = run.frame(est, t, seed);
     ASSERT_FALSE(last.reset) << last.event;
     if (!last.initialized) continue;
@@ -40,8 +41,8 @@ TEST(SlidingWindow, SeededFromTruthTracksTwentySecondsWithinFiveCentimetres) {
     worst = std::max(worst, positionError(last, scene));
     worst_rot = std::max(worst_rot, rotationErrorDeg(last, scene));
   }
-  EXPECT_GT(estimated, 250);
-  EXPECT_LT(worst, 0.05) << "m";
+  EXPECT_GT(estimated, 150);
+  EXPECT_LT(worst, 0.02) << "m";
   EXPECT_LT(worst_rot, 0.5) << "deg";
   EXPECT_LT((last.bias.gyro - scene.gyro_bias).norm(), 1e-3);
   EXPECT_LT((last.bias.acc - scene.acc_bias).norm(), 0.05);
@@ -70,7 +71,7 @@ TEST(SlidingWindow, EstimatesTheCameraTimeOffset) {
   WindowRun run{scene};
   const double td = 0.008;  // [s] the camera stamps are 8 ms early: t_imu = t_camera + td
   FrameResult last;
-  for (double t = 0.05; t < 15; t += 1.0 / run.camera_hz) {
+  for (double t = 0.05; t < 8; t += 1.0 / run.camera_hz) {
     last = run.frame(est, t, truthSeeder(scene), td);
     ASSERT_FALSE(last.reset) << last.event;
   }
@@ -92,12 +93,12 @@ TEST(SlidingWindow, LidarDepthHeldFixedOrAsFactorKeepsTheEstimateOnTruth) {
     };
     FrameResult last;
     int with_depth = 0;
-    for (double t = 0.05; t < 10; t += 1.0 / run.camera_hz) {
+    for (double t = 0.05; t < 5; t += 1.0 / run.camera_hz) {
       last = run.frame(est, t, truthSeeder(scene));
       ASSERT_FALSE(last.reset) << toString(mode) << ": " << last.event;
       with_depth = std::max(with_depth, last.with_lidar_depth);
     }
-    EXPECT_GT(with_depth, 20) << toString(mode);
+    EXPECT_GT(with_depth, 10) << toString(mode);
     EXPECT_LT(positionError(last, scene), 0.05) << toString(mode);
   }
 }
@@ -113,7 +114,7 @@ TEST(SlidingWindow, DropsObservationsThatAreOutliers) {
   };
   int outliers = 0;
   FrameResult last;
-  for (double t = 0.05; t < 10; t += 1.0 / run.camera_hz) {
+  for (double t = 0.05; t < 6; t += 1.0 / run.camera_hz) {
     last = run.frame(est, t, truthSeeder(scene));
     ASSERT_FALSE(last.reset) << last.event;
     outliers += last.outliers;

@@ -10,6 +10,7 @@ namespace {
 VioConfig base() {
   VioConfig c;
   c.estimate_time_offset = false;
+  c.max_features = 60;
   return c;
 }
 
@@ -33,16 +34,16 @@ void expectReset(const FrameResult& r, const std::string& words) {
 TEST(WindowFailure, HealthyRunNeverResets) {
   const WindowScene scene;
   WindowRun run{scene};
-  EXPECT_FALSE(firstReset(base(), 8, run, scene).reset);
+  EXPECT_FALSE(firstReset(base(), 5, run, scene).reset);
 }
 
 TEST(WindowFailure, TooFewTrackedFeaturesResets) {
   const WindowScene scene;
   WindowRun run{scene};
   run.edit = [](double t, std::vector<FrameFeature>& fs) {
-    if (t > 3 && fs.size() > 4) fs.resize(4);  // a textureless stretch
+    if (t > 2 && fs.size() > 4) fs.resize(4);  // a textureless stretch
   };
-  expectReset(firstReset(base(), 6, run, scene), "features tracked");
+  expectReset(firstReset(base(), 4, run, scene), "features tracked");
 }
 
 TEST(WindowFailure, ImplausibleAccelerometerBiasResets) {
@@ -109,8 +110,8 @@ TEST(WindowFailure, AnImuGapClearsTheWindowAndItReinitialises) {
   SlidingWindowEstimator est(base(), imu::PreintegrationConfig{}, scene.T_imu_cam, 460);
   WindowRun run{scene};
   bool reset = false, again = false;
-  for (double t = 0.05; t < 8; t += 1.0 / run.camera_hz) {
-    if (t > 3 && t < 3.5) {
+  for (double t = 0.05; t < 5; t += 1.0 / run.camera_hz) {
+    if (t > 2 && t < 2.5) {
       run.t_imu = t + 0.6;  // the IMU goes silent past the next frames
       continue;
     }

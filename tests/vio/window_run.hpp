@@ -9,6 +9,7 @@
 namespace drover::vio::test {
 
 struct WindowRun {
+  explicit WindowRun(const WindowScene& s) : scene(s) {}
   const WindowScene& scene;
   double camera_hz = 15;
   double imu_hz = 200;
