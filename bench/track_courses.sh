@@ -2,7 +2,8 @@
 # Feature tracking figures on simulated courses (issue 6): `drover features track` with each detector on a 20 s
 # `straight` course and the `lighting` course (dark stretches), and the share of frames that keep >= 50 tracked
 # features inside the dark stretches (the middle 20-45 % of each labelled `lighting` segment, where the scene
-# light is at its 0.08 floor: src/sim/scenario_world.cpp LightingPlan::temporal).
+# light is at its night level, 5e-4 of daylight, below the camera's auto-exposure floor:
+# src/sim/scenario_world.cpp LightingPlan::temporal, src/sim/camera_exposure.hpp).
 # Courses are generated once (cached in $DROVER_OUT/sim/<name>_track). Writes bench/out/tracking/<course>_<detector>/
 # (tracks.json) and bench/out/tracking.md (the table).
 # Usage: bash bench/track_courses.sh [detector ...]   (default: shi-tomasi orb superpoint)

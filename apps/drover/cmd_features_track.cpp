@@ -52,16 +52,23 @@ Json frameJson(const visual::TrackingResult& r, Time t0) {
 }
 
 Json summaryJson(const visual::TrackingSummary& s) {
+  Json ended_by = Json::object();
+  for (int c = 0; c < visual::kTrackEndCount; ++c)
+    ended_by[visual::trackEndName(static_cast<visual::TrackEnd>(c))] = {
+        {"tracks", s.ended_by[static_cast<std::size_t>(c)]},
+        {"mean_length", s.mean_length_by[static_cast<std::size_t>(c)]}};
   return Json{{"frames", s.frames},
               {"mean_features", s.mean_features},
               {"mean_new", s.mean_new},
               {"mean_track_length", s.mean_track_length},
               {"finished_tracks", s.finished_tracks},
+              {"mean_live_length", s.mean_live_length},
               {"ransac_inlier_ratio", s.mean_inlier_ratio},
               {"ms_per_frame", s.mean_ms},
               {"ms_p95", s.p95_ms},
               {"ms_max", s.max_ms},
-              {"fraction_tracked_ge_50", s.fraction_tracked_ge_50}};
+              {"fraction_tracked_ge_50", s.fraction_tracked_ge_50},
+              {"ended_by", ended_by}};
 }
 
 void runTrack(const TrackOptions& o) {

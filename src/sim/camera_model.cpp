@@ -65,6 +65,8 @@ std::string CameraModelConfig::validate() const {
     error << "camera noise_sigma must be >= 0 and finite, got " << noise_sigma;
   } else if (!sky.allFinite() || sky.minCoeff() < 0) {
     error << "camera sky colour must be finite and >= 0, got (" << sky.transpose() << ")";
+  } else if (std::string e = exposure.validate(); !e.empty()) {
+    error << e;
   }
   return error.str();
 }

@@ -1,8 +1,10 @@
 #pragma once
 // Pinhole camera with radial-tangential distortion, rendered by casting one ray per pixel into the textured world.
-// Brightness = texture colour * illumination(t, hit) * Lambert(normal) where a surface is hit, sky * illumination
-// where nothing is, then Gaussian read noise and 8-bit quantisation (linear: grey = 255 * value, no gamma).
-// Optional motion blur averages sub-frames over the exposure time.
+// Scene value = texture colour * illumination(t, hit) * Lambert(normal) where a surface is hit, sky * illumination
+// where nothing is (1 = a white surface facing the sun in daylight). Two cameras read it: the ideal one here
+// (render(): grey = 255 * value + Gaussian read noise, 8-bit, linear, no gamma) and the real one of
+// camera_exposure.hpp (photo-electrons over an exposure time, shot and read noise, analogue gain, auto exposure),
+// which the simulator uses. Optional motion blur averages sub-frames over the exposure time.
 //
 // Pixel convention (as OpenCV / Kalibr): integer pixel coordinates are pixel centres, so pixel (u, v) spans
 // [u - 0.5, u + 0.5] x [v - 0.5, v + 0.5] and the image spans [-0.5, width - 0.5] x [-0.5, height - 0.5].
@@ -17,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "sim/camera_exposure.hpp"
 #include "sim/trajectory.hpp"
 #include "sim/world.hpp"
 #include "types/calibration.hpp"
@@ -29,15 +32,24 @@ namespace drover::sim {
 // Scenarios supply it (dark segments, exposure ramps, flicker); the default is uniform daylight.
 using Illumination = std::function<float(Time t, const Eigen::Vector3d& p_world)>;
 
+// The scene as an ideal camera sees it: per pixel and channel the "ideal grey" 255 * value (mono: luma; colour:
+// B, G, R), unclipped and without noise. Row-major, channels interleaved.
+struct RadianceImage {
+  int width = 0, height = 0, channels = 1;
+  std::vector<float> grey;  // [ideal grey levels] width * height * channels
+};
+
 struct CameraModelConfig {
   CameraIntrinsics intrinsics = defaultIntrinsics();  // 640x480, fx = fy = 460, rad-tan (EuRoC-like)
   double rate_hz = 15.0;               // [Hz]
-  double exposure_s = 0.01;            // [s] exposure time (for motion blur), < 1 / rate_hz
+  double exposure_s = 0.01;            // [s] ideal camera's exposure (motion blur); < 1 / rate_hz. The real camera's
+                                       // exposure comes from its auto exposure (exposure below)
   int motion_blur_samples = 1;         // 1 = no blur; N sub-frames averaged over the exposure (<= 64)
   double noise_sigma = 2.0;            // [grey levels of 255], Gaussian read noise
   bool color = false;                  // false: mono8 (as most VIO cameras); true: bgr8
   Eigen::Vector3f sky = Eigen::Vector3f(0.7f, 0.8f, 0.95f);  // linear RGB where no surface is hit (outdoors)
-  bool noise = true;
+  bool noise = true;                   // false: no noise in either camera (exact sensors)
+  CameraExposureConfig exposure;       // the real camera: sensor, gain and auto exposure (camera_exposure.hpp)
   // 640x480, fx = fy = 460, cx = 319.5, cy = 239.5, rad-tan k1 = -0.28, k2 = 0.07, p1 = 2e-4, p2 = -1e-4.
   static CameraIntrinsics defaultIntrinsics();
   // Empty when valid, else names the bad value. Supports DistortionModel::kNone and kRadialTangential (4 or 5
@@ -69,12 +81,17 @@ class CameraRenderer {
  public:
   // Throws std::invalid_argument when config.validate() fails or a pixel cannot be undistorted.
   explicit CameraRenderer(const CameraModelConfig& config);
-  // Renders the frame exposed at t (mid-exposure) from T_world_body(t) * T_body_cam. Rows render in parallel;
-  // noise is counter-based (seed, frame_index, pixel), so output is identical for any thread count. With motion
+  // The ideal camera: the frame exposed at t (mid-exposure) from T_world_body(t) * T_body_cam. Rows render in
+  // parallel; noise is counter-based (seed, frame_index, pixel), so output is identical for any thread count. With motion
   // blur, sub-frame i of N is at t + exposure * ((i + 0.5) / N - 0.5), clamped to the trajectory's span.
   // An empty `illumination` means uniform daylight (1). Throws std::out_of_range when t is outside the trajectory.
   CameraFrame render(const World& world, const SplineTrajectory& trajectory, const Eigen::Isometry3d& T_body_cam,
                      const Illumination& illumination, Time t, std::uint64_t seed, std::uint64_t frame_index) const;
+  // The scene before any sensor: ideal grey per pixel, motion blur (if configured) over `exposure_s` [s] centred on
+  // t. Deterministic (no noise). Throws std::out_of_range when t is outside the trajectory.
+  RadianceImage renderRadiance(const World& world, const SplineTrajectory& trajectory,
+                               const Eigen::Isometry3d& T_body_cam, const Illumination& illumination, Time t,
+                               double exposure_s) const;
   const CameraModelConfig& config() const { return config_; }
 
   // Pixel [px] of a camera-frame point: distort + K. Nothing when the point is not in front of the camera
@@ -89,7 +106,7 @@ class CameraRenderer {
  private:
   struct SubFrame;
   void renderRow(const World& world, const std::vector<SubFrame>& subframes, const Illumination& illumination,
-                 int v, std::uint64_t seed, std::uint64_t frame_index, std::uint8_t* row) const;
+                 int v, float* row) const;
 
   CameraModelConfig config_;
   std::size_t width_ = 0;

@@ -56,8 +56,8 @@ struct ScenarioOptions {
 // static IMU initialisation) with |a| <= 0.4 m/s^2 along the path and <= 0.3 m/s^2 across it, and sampled every
 // 0.1 s (yaw = heading unwrapped, pitch = -atan(grade), roll = 0). Body height kBodyHeight above the surface.
 // Jolting adds vibrations (z 1.5 cm at 2.5 Hz + 0.4 cm at 6.1 Hz, pitch 1.5 + 0.5 deg at 1.8 / 4.4 Hz, roll 2 +
-// 0.6 deg at 1.3 / 3.7 Hz). Lighting: outdoor 1, indoor 0.5, and over each "lighting" span an exposure ramp down
-// to 0.08, a dark stretch, a ramp back and 4 Hz flicker of depth 0.3. "overlap" segments are found, not declared:
+// 0.6 deg at 1.3 / 3.7 Hz). Lighting: outdoor 1, indoor 0.5, and over each "lighting" span a geometric ramp down
+// to a night level of 5e-4, a dark stretch, a ramp back and 4 Hz flicker of depth 0.3. "overlap" segments are found, not declared:
 // wherever the path comes within 2 m of where it was >= 30 s before.
 // Approximations: sharp turns are tight arcs (r = 1.5 m at 0.5 m/s), not turns on the spot; a ramp's surface is
 // planar, so over its 2 m vertical transitions the body is up to ~3 cm off kBodyHeight; fences and pens are flat

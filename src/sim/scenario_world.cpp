@@ -73,9 +73,10 @@ float LightingPlan::temporal(Time t) const {
     if (t < e.start || t > e.end) continue;
     const double span = toSeconds(e.end - e.start);
     const double u = toSeconds(t - e.start) / span;
-    if (u < 0.2) return 1.0f + (dark - 1.0f) * smoothstep(u / 0.2);            // exposure ramp down
-    if (u < 0.45) return dark;                                                 // dark stretch
-    if (u < 0.6) return dark + (1.0f - dark) * smoothstep((u - 0.45) / 0.15);  // ramp back up
+    const auto towards_dark = [&](double s) { return static_cast<float>(std::pow(dark, smoothstep(s))); };
+    if (u < 0.2) return towards_dark(u / 0.2);                  // ramp down: 1 -> dark geometrically
+    if (u < 0.45) return dark;                                  // dark stretch
+    if (u < 0.6) return towards_dark(1.0 - (u - 0.45) / 0.15);  // ramp back up
     const double tf = toSeconds(t - e.start) - 0.6 * span;                     // flicker from 1
     return 1.0f - flicker_depth * static_cast<float>(0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * flicker_hz * tf)));
   }

@@ -24,13 +24,16 @@ Box yawBox(const Eigen::Vector3d& base, const Eigen::Vector3d& half, double yaw)
 Footprint footprintOf(const Box& box);
 Footprint footprintOf(const Rectangle& vertical_rect);
 
-// Timed lighting: within [start, end] the scene light follows an exposure ramp down to dark, a dark stretch,
-// a ramp back up and then flicker (mains flicker aliased to a few Hz by the camera rate).
+// Timed lighting: within [start, end] the scene light follows a ramp down to dark (geometric: the light falls by the
+// same factor per second, as at dusk), a dark stretch, a ramp back up and then flicker (mains flicker aliased to a
+// few Hz by the camera rate). `dark` is a night light level: 5e-4 of daylight, e.g. ~5-50 lux under a lamp against
+// ~10^4-10^5 lux of daylight; indoors (x 0.5) it is below what the camera's auto exposure can make up for
+// (camera_exposure.hpp: exposure and gain give ~500x), so the images get dark and noisy, as at night.
 struct LightingEvent {
   Time start = 0, end = 0;  // [ns]
 };
 struct LightingPlan {
-  float outdoor = 1.0f, indoor = 0.5f, dark = 0.08f;
+  float outdoor = 1.0f, indoor = 0.5f, dark = 5e-4f;
   float flicker_depth = 0.3f;
   double flicker_hz = 4.0;  // [Hz], e.g. 100 Hz mains seen by a 15.2 Hz camera
   std::vector<IndoorRegion> indoor_regions;

@@ -2,6 +2,7 @@
 #include "sim/simulator.hpp"
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <stdexcept>
 
 #include "io/sim_dataset.hpp"
+#include "sim/camera_stream.hpp"
 #include "sim/random.hpp"
 
 namespace drover::sim {
@@ -162,43 +164,52 @@ void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) 
   if (config_.enable_imu) imu = simulateImu(trajectory, config_.imu, imu_seed);
   const std::vector<Time> sweeps = sweepStarts();
   const std::vector<Time> frames = frameTimes();
-  std::optional<CameraRenderer> renderer;
-  if (config_.enable_camera) renderer.emplace(config_.camera);
+  // The camera runs in frame order (its auto exposure meters each frame for the next); sweeps run in parallel.
+  std::optional<CameraStream> camera;
+  if (config_.enable_camera) camera.emplace(config_.camera);
 
   const std::vector<Slot> schedule =
       buildSchedule(imu, sweeps, frames, config_.lidar_time_offset, config_.camera_time_offset);
-  // One sweep or frame, stamped with the sensor's clock.
-  const auto compute = [&](const Slot& s) -> Measurement {
-    if (s.sensor == 1) {
-      LidarScan scan = simulateSweep(scenario_.world, trajectory, config_.T_imu_lidar, sweeps[s.index], config_.lidar,
-                                     lidar_seed, s.index);
-      const Time duration = scan.t_end - scan.t;
-      scan.t = s.stamp;
-      scan.t_end = s.stamp + duration;
-      return scan;
-    }
-    CameraFrame frame = renderer->render(scenario_.world, trajectory, config_.T_imu_cam, scenario_.illumination,
-                                         frames[s.index], camera_seed, s.index);
-    frame.t = s.stamp;
-    return frame;
+  const auto sweep = [&](const Slot& s) -> Measurement {
+    LidarScan scan = simulateSweep(scenario_.world, trajectory, config_.T_imu_lidar, sweeps[s.index], config_.lidar,
+                                   lidar_seed, s.index);
+    const Time duration = scan.t_end - scan.t;
+    scan.t = s.stamp;
+    scan.t_end = s.stamp + duration;
+    return scan;
+  };
+  const auto frame = [&](const Slot& s) -> Measurement {
+    CameraFrame f = camera->next(scenario_.world, trajectory, config_.T_imu_cam, scenario_.illumination,
+                                 frames[s.index], camera_seed, s.index);
+    f.t = s.stamp;
+    return f;
   };
   std::size_t begin = 0;
   while (begin < schedule.size()) {
     const Time chunk_end = schedule[begin].stamp + chunk;
     std::size_t end = begin;
     while (end < schedule.size() && schedule[end].stamp < chunk_end) ++end;
-    // Sweeps and frames of this chunk, computed in parallel into their slots.
-    std::vector<std::size_t> heavy;
-    for (std::size_t i = begin; i < end; ++i)
-      if (schedule[i].sensor != 0) heavy.push_back(i);
-    std::vector<std::optional<Measurement>> results(heavy.size());
-    tbb::parallel_for(std::size_t{0}, heavy.size(), [&](std::size_t h) { results[h] = compute(schedule[heavy[h]]); });
-    std::size_t h = 0;
+    // Sweeps of this chunk in parallel, alongside its frames in order; each into its slot.
+    std::vector<std::size_t> lidar_slots, camera_slots;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (schedule[i].sensor == 1) lidar_slots.push_back(i);
+      if (schedule[i].sensor == 2) camera_slots.push_back(i);
+    }
+    std::vector<std::optional<Measurement>> results(end - begin);
+    tbb::parallel_invoke(
+        [&] {
+          tbb::parallel_for(std::size_t{0}, lidar_slots.size(), [&](std::size_t h) {
+            results[lidar_slots[h] - begin] = sweep(schedule[lidar_slots[h]]);
+          });
+        },
+        [&] {
+          for (std::size_t i : camera_slots) results[i - begin] = frame(schedule[i]);
+        });
     for (std::size_t i = begin; i < end; ++i) {
       if (schedule[i].sensor == 0)
         sink(Measurement(imu[schedule[i].index]));
       else
-        sink(std::move(*results[h++]));
+        sink(std::move(*results[i - begin]));
     }
     begin = end;
   }

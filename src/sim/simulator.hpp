@@ -22,7 +22,7 @@ struct SimDatasetDescription;  // io/sim_dataset.hpp (plain data; the sim librar
 namespace drover::sim {
 
 // Version of the generator, written into scenario.json; bump when the same seed would give different data.
-constexpr const char* kGeneratorVersion = "drover-sim 1";
+constexpr const char* kGeneratorVersion = "drover-sim 2";
 
 struct SimulatorConfig {
   LidarModelConfig lidar = LidarModelConfig::forModel("vlp16");

@@ -100,10 +100,32 @@ cv::Mat FeatureTracker::preprocess(const cv::Mat& image, TrackingResult& result)
   return gray;
 }
 
-std::vector<unsigned char> FeatureTracker::keepFinished(std::vector<unsigned char> keep, TrackingResult& result) const {
+const char* trackEndName(TrackEnd end) {
+  switch (end) {
+    case TrackEnd::kLostFlow: return "lost_flow";
+    case TrackEnd::kForwardBackward: return "rejected_fb";
+    case TrackEnd::kBorder: return "rejected_border";
+    case TrackEnd::kRansac: return "rejected_ransac";
+    case TrackEnd::kCrowded: return "dropped_crowded";
+  }
+  return "?";
+}
+
+std::vector<unsigned char> FeatureTracker::keepFinished(std::vector<unsigned char> keep,
+                                                        const std::vector<TrackEnd>& causes,
+                                                        TrackingResult& result) const {
   for (std::size_t i = 0; i < keep.size(); ++i)
-    if (!keep[i]) result.finished_lengths.push_back(tracks_.lengths[i]);
+    if (!keep[i]) {
+      result.finished_lengths.push_back(tracks_.lengths[i]);
+      result.finished_causes.push_back(causes[i]);
+    }
   return keep;
+}
+
+std::vector<unsigned char> FeatureTracker::keepFinished(std::vector<unsigned char> keep, TrackEnd cause,
+                                                        TrackingResult& result) const {
+  const std::vector<TrackEnd> causes(keep.size(), cause);
+  return keepFinished(std::move(keep), causes, result);
 }
 
 void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result) {
@@ -124,6 +146,7 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
                              criteria, cv::OPTFLOW_USE_INITIAL_FLOW);
   }
   std::vector<unsigned char> keep(status.size(), 0);
+  std::vector<TrackEnd> causes(status.size(), TrackEnd::kLostFlow);
   std::vector<Eigen::Vector2d> previous_normalized = tracks_.normalized;  // for RANSAC
   for (std::size_t i = 0; i < status.size(); ++i) {
     if (!status[i]) {
@@ -133,11 +156,13 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
     if (config_.forward_backward &&
         (!back_status[i] || cv::norm(back[i] - tracks_.pixels[i]) > config_.forward_backward_px)) {
       ++result.rejected_fb;
+      causes[i] = TrackEnd::kForwardBackward;
       continue;
     }
     const auto xn = inside(current[i]) ? camera_.undistort({current[i].x, current[i].y}) : std::nullopt;
     if (!xn) {
       ++result.rejected_border;
+      causes[i] = TrackEnd::kBorder;
       continue;
     }
     keep[i] = 1;
@@ -146,7 +171,7 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
     tracks_.pixels[i] = current[i];
     ++tracks_.lengths[i];
   }
-  tracks_.keep(keepFinished(keep, result));
+  tracks_.keep(keepFinished(keep, causes, result));
   std::size_t j = 0;
   for (std::size_t i = 0; i < keep.size(); ++i)
     if (keep[i]) previous_normalized[j++] = previous_normalized[i];
@@ -178,7 +203,7 @@ void FeatureTracker::rejectWithFundamental(const std::vector<Eigen::Vector2d>& p
   for (unsigned char s : inlier) inliers += s ? 1 : 0;
   result.rejected_ransac = static_cast<int>(tracks_.size()) - inliers;
   result.inlier_ratio = static_cast<double>(inliers) / static_cast<double>(tracks_.size());
-  tracks_.keep(keepFinished(inlier, result));
+  tracks_.keep(keepFinished(inlier, TrackEnd::kRansac, result));
 }
 
 TrackingResult FeatureTracker::track(Time t, const cv::Mat& image) {

@@ -51,6 +51,11 @@ struct FeatureTrackerConfig {
   std::string validate() const;     // empty = valid, else names the bad value
 };
 
+// Why a track ended (TrackingResult's counters, one per cause).
+enum class TrackEnd { kLostFlow, kForwardBackward, kBorder, kRansac, kCrowded };
+inline constexpr int kTrackEndCount = 5;
+const char* trackEndName(TrackEnd end);  // "lost_flow", "rejected_fb", "rejected_border", "rejected_ransac", "dropped_crowded"
+
 struct TrackedFeature {
   std::uint64_t id = 0;           // persistent while the feature is tracked, never reused
   int track_length = 0;           // frames this feature has been seen in, 1 on the frame it was detected
@@ -73,6 +78,7 @@ struct TrackingResult {
   double inlier_ratio = 1.0;  // RANSAC inliers / points tested (1 when not run)
   bool clahe_applied = false;
   std::vector<int> finished_lengths;  // track lengths of the features that ended at this frame
+  std::vector<TrackEnd> finished_causes;  // why each of them ended (parallel to finished_lengths)
   double ms = 0;              // [ms] wall time of track()
 };
 
@@ -111,7 +117,11 @@ class FeatureTracker {
   void replenish(const cv::Mat& gray, TrackingResult& result);
   void addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result);
   bool inside(const cv::Point2f& p) const;
-  std::vector<unsigned char> keepFinished(std::vector<unsigned char> keep, TrackingResult& result) const;
+  // Records the tracks keep[i] == 0 drops as finished, for causes[i] (or `cause` for all), and returns keep.
+  std::vector<unsigned char> keepFinished(std::vector<unsigned char> keep, const std::vector<TrackEnd>& causes,
+                                          TrackingResult& result) const;
+  std::vector<unsigned char> keepFinished(std::vector<unsigned char> keep, TrackEnd cause,
+                                          TrackingResult& result) const;
 
   CameraModel camera_;
   std::shared_ptr<KeypointDetector> detector_;

@@ -32,7 +32,7 @@ cv::Mat FeatureTracker::crowdMask(TrackingResult& result) {
     keep[i] = 1;
     if (radius > 0) cv::circle(mask, pixel, radius, cv::Scalar(0), cv::FILLED);
   }
-  tracks_.keep(keepFinished(keep, result));
+  tracks_.keep(keepFinished(keep, TrackEnd::kCrowded, result));
   result.tracked -= result.dropped_crowded;
   return mask;
 }

@@ -12,7 +12,17 @@ void TrackingSummaryBuilder::add(const TrackingResult& r) {
   features_ += static_cast<double>(r.features.size());
   new_ += r.added;
   for (int length : r.finished_lengths) lengths_ += length;
+  if (!r.features.empty()) {
+    double live = 0;
+    for (const TrackedFeature& f : r.features) live += f.track_length;
+    live_lengths_ += live / static_cast<double>(r.features.size());
+  }
   finished_ += r.finished_lengths.size();
+  for (std::size_t i = 0; i < r.finished_causes.size() && i < r.finished_lengths.size(); ++i) {
+    const auto cause = static_cast<std::size_t>(r.finished_causes[i]);
+    ++ended_by_[cause];
+    lengths_by_[cause] += r.finished_lengths[i];
+  }
   if (r.ransac_run) {
     inliers_ += r.inlier_ratio;
     ++ransac_frames_;
@@ -29,6 +39,10 @@ TrackingSummary TrackingSummaryBuilder::summary() const {
   s.mean_new = new_ / n;
   s.finished_tracks = finished_;
   s.mean_track_length = finished_ > 0 ? lengths_ / static_cast<double>(finished_) : 0;
+  s.mean_live_length = live_lengths_ / n;
+  s.ended_by = ended_by_;
+  for (std::size_t c = 0; c < ended_by_.size(); ++c)
+    s.mean_length_by[c] = ended_by_[c] > 0 ? lengths_by_[c] / static_cast<double>(ended_by_[c]) : 0;
   s.mean_inlier_ratio = ransac_frames_ > 0 ? inliers_ / static_cast<double>(ransac_frames_) : 1;
   std::vector<double> ms = ms_;
   std::sort(ms.begin(), ms.end());

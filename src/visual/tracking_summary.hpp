@@ -1,6 +1,7 @@
 #pragma once
 // Figures of a tracking run (drover features track, benchmarks): per-frame counts accumulated into means, and an
 // overlay image of the live tracks (drawing only; writing the file is io's job).
+#include <array>
 #include <cstddef>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -18,6 +19,12 @@ struct TrackingSummary {
   // length is cut by the end of the run), so short runs understate long tracks.
   double mean_track_length = 0;
   std::size_t finished_tracks = 0;
+  // Mean over frames of the live features' track lengths [frames] (age of what the VIO window sees; not biased
+  // toward the many tracks that die young, as mean_track_length is).
+  double mean_live_length = 0;
+  // The finished tracks by why they ended (index: TrackEnd), with their mean length [frames].
+  std::array<std::size_t, kTrackEndCount> ended_by{};
+  std::array<double, kTrackEndCount> mean_length_by{};
   double mean_inlier_ratio = 1;      // over frames where RANSAC ran
   double mean_ms = 0, p95_ms = 0, max_ms = 0;  // [ms] per track() call
   // Fraction of frames (after the first) that carried >= 50 features over from the previous frame.
@@ -32,7 +39,9 @@ class TrackingSummaryBuilder {
  private:
   std::vector<double> ms_;
   std::size_t frames_ = 0, finished_ = 0, ransac_frames_ = 0, ge50_ = 0;
-  double features_ = 0, new_ = 0, lengths_ = 0, inliers_ = 0;
+  double features_ = 0, new_ = 0, lengths_ = 0, inliers_ = 0, live_lengths_ = 0;
+  std::array<std::size_t, kTrackEndCount> ended_by_{};
+  std::array<double, kTrackEndCount> lengths_by_{};
 };
 
 // A BGR copy of `image` (grey or BGR) with each live feature drawn as a dot coloured by track length (red = new,

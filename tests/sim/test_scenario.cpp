@@ -256,8 +256,9 @@ TEST(LightingScenario, RampsToDarkAndBackThenFlickersWithinItsSpanOnly) {
   const auto at = [&](double u) { return s.illumination(seg->start + static_cast<Time>(u * span), outdoors); };
   EXPECT_FLOAT_EQ(s.illumination(seg->start - kTenHz, outdoors), 1.0f);
   EXPECT_FLOAT_EQ(s.illumination(seg->end + kTenHz, outdoors), 1.0f);
-  EXPECT_NEAR(at(0.1), 0.54f, 1e-3);  // halfway down the exposure ramp (smoothstep)
-  EXPECT_FLOAT_EQ(at(0.3), 0.08f);    // dark
+  // Halfway down the ramp (smoothstep of the exponent: geometric, 1 -> 5e-4 over 3.3 decades) and dark (a night level).
+  EXPECT_NEAR(at(0.1), std::sqrt(5e-4f), 1e-5);
+  EXPECT_FLOAT_EQ(at(0.3), 5e-4f);
   float lo = 1.0f, hi = 0.0f;         // flicker of depth 0.3
   for (double u = 0.62; u < 1.0; u += 0.0005) lo = std::min(lo, at(u)), hi = std::max(hi, at(u));
   EXPECT_NEAR(lo, 0.7f, 2e-3);
