@@ -28,7 +28,8 @@ std::vector<double> values(ParamFile& f, Output& o, const std::string& section,
 void setIntrinsics(Output& o, const std::vector<double>& k, const char* model, const std::vector<double>& d,
                    const std::string& source) {
   const char* names[] = {"fx", "fy", "cx", "cy"};
-  for (std::size_t i = 0; i < 4; ++i) o.tree.set(std::string("calibration.camera.") + names[i], yamlNumber(k[i]), "[px]");
+  for (std::size_t i = 0; i < 4; ++i)
+    o.tree.set(std::string("calibration.camera.") + names[i], yamlNumber(k[i]), "[px]");
   o.tree.set("calibration.camera.distortion_model", model, source);
   o.tree.set("calibration.camera.distortion_coeffs", yamlList(d, 0));
 }
@@ -38,16 +39,21 @@ bool startsWith(const std::string& s, const std::string& prefix) { return s.rfin
 // PINHOLE (rad-tan) and KANNALA_BRANDT (equidistant: theta_d = theta + k2 theta^3 + ... + k5 theta^9, which is
 // OpenCV's fisheye k1..k4) map to calibration.camera; MEI (unified omnidirectional, xi) and SCARAMUZZA have no
 // counterpart, and a pinhole stand-in would be wrong at their fields of view: the images are then not loaded.
-// Returns whether the camera could be represented.
-bool mapCameraModel(ParamFile& f, Output& o) {
-  const std::string model = f.text("model_type").value_or("PINHOLE");
-  const auto w = f.integer("image_width", 1, 100000);
-  const auto h = f.integer("image_height", 1, 100000);
-  if (model == "PINHOLE" || model == "KANNALA_BRANDT") {
-    if (w) o.tree.set("calibration.camera.width", std::to_string(*w), "[px] image_width");
-    if (h) o.tree.set("calibration.camera.height", std::to_string(*h), "[px] image_height");
-    if (w) o.map(f, "image_width", "calibration.camera.width");
-    if (h) o.map(f, "image_height", "calibration.camera.height");
+// Returns why the camera cannot be used, empty when it can.
+std::string mapCameraModel(ParamFile& f, Output& o) {
+  if (!f.has("model_type") && !f.has("projection_parameters")) return "the camera file gives no camera model";
+  const std::string model = f.text("model_type").value_or("PINHOLE");  // camodocs' default
+  const bool supported = model == "PINHOLE" || model == "KANNALA_BRANDT";
+  for (const char* key : {"image_width", "image_height"}) {
+    const auto v = f.integer(key, 1, 100000);
+    if (!v) continue;
+    const std::string target = std::string("calibration.camera.") + (key[6] == 'w' ? "width" : "height");
+    if (supported) {
+      o.tree.set(target, std::to_string(*v), std::string("[px] ") + key);
+      o.map(f, key, target);
+    } else {
+      o.ignore(f, key, "belongs to the " + model + " camera model, which Drover cannot represent");
+    }
   }
   if (model == "PINHOLE") {
     const auto k = values(f, o, "projection_parameters", {{"fx", "fx"}, {"fy", "fy"}, {"cx", "cx"}, {"cy", "cy"}},
@@ -57,8 +63,8 @@ bool mapCameraModel(ParamFile& f, Output& o) {
                            {"p1", "distortion_coeffs[2]"}, {"p2", "distortion_coeffs[3]"}},
                           Range{});
     setIntrinsics(o, k, "radial-tangential", d, "model_type PINHOLE");
-    o.map(f, "model_type", "calibration.camera.distortion_model: radial-tangential");
-    return true;
+    if (f.has("model_type")) o.map(f, "model_type", "calibration.camera.distortion_model: radial-tangential");
+    return "";
   }
   if (model == "KANNALA_BRANDT") {
     const auto p = values(f, o, "projection_parameters", {{"mu", "fx"}, {"mv", "fy"}, {"u0", "cx"}, {"v0", "cy"}},
@@ -69,17 +75,17 @@ bool mapCameraModel(ParamFile& f, Output& o) {
                           Range{});
     setIntrinsics(o, p, "equidistant", d, "model_type KANNALA_BRANDT");
     o.map(f, "model_type", "calibration.camera.distortion_model: equidistant");
-    return true;
+    return "";
   }
   o.ignore(f, "model_type",
            "model_type " + model +
                ": Drover's cameras are pinhole (rad-tan) or equidistant; this model cannot be represented, so "
                "images are not loaded (load_images: false) and the run is lidar-inertial");
   for (const std::string& key : f.unused())
-    if (key == "image_width" || key == "image_height" || startsWith(key, "mirror_parameters") ||
-        startsWith(key, "distortion_parameters") || startsWith(key, "projection_parameters"))
+    if (startsWith(key, "mirror_parameters") || startsWith(key, "distortion_parameters") ||
+        startsWith(key, "projection_parameters"))
       o.ignore(f, key, "belongs to the " + model + " camera model, which Drover cannot represent");
-  return false;
+  return "the " + model + " camera model cannot be represented (see the parameters not imported)";
 }
 
 // extrinsicRotation = imu^R_cam, extrinsicTranslation = imu^t_cam: T_imu_cam directly.
@@ -213,9 +219,8 @@ void mapCameraFile(ParamFile& f, Output& o, bool have_lidar_file) {
                                    ", which dataset.imu_topic took: Drover reads one IMU topic");
     }
   }
-  const bool camera_ok = mapCameraModel(f, o);
-  o.tree.set("dataset.load_images", camera_ok ? "true" : "false",
-             camera_ok ? "" : "the camera model cannot be represented (see the ignored keys)");
+  const std::string unusable = mapCameraModel(f, o);
+  o.tree.set("dataset.load_images", unusable.empty() ? "true" : "false", unusable);
   mapExtrinsics(f, o);
   mapImuNoise(f, o, have_lidar_file);
   mapFrontEnd(f, o);

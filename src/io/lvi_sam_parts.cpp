@@ -161,7 +161,9 @@ void ConfigTree::set(const std::string& dotted, std::string value, std::string c
   n.comment = std::move(comment);
 }
 
-void ConfigTree::note(const std::string& dotted, std::string comment) { at(dotted).notes.push_back(std::move(comment)); }
+void ConfigTree::note(const std::string& dotted, std::string comment) {
+  at(dotted).notes.push_back(std::move(comment));
+}
 
 bool ConfigTree::has(const std::string& dotted) const {
   const Node* n = &root_;

@@ -162,7 +162,8 @@ TEST(LviSamImport, TheMeiCameraIsListedAsNotRepresentableAndImagesAreNotLoaded) 
   ASSERT_NE(model, nullptr);
   EXPECT_TRUE(has(model->note, "MEI")) << model->note;
   EXPECT_TRUE(has(model->note, "cannot be represented")) << model->note;
-  for (const char* k : {"mirror_parameters.xi", "projection_parameters.gamma1", "distortion_parameters.p2", "image_width"})
+  for (const char* k :
+       {"mirror_parameters.xi", "projection_parameters.gamma1", "distortion_parameters.p2", "image_width"})
     EXPECT_NE(find(r.ignored, k), nullptr) << k;
   EXPECT_FALSE(at(r, "dataset.load_images").as<bool>());
   EXPECT_FALSE(at(r, "calibration.camera"));
