@@ -18,6 +18,7 @@ void registerRun(CLI::App& app);
 void registerLoop(CLI::App& app);      // cmd_loop.cpp: drover loop pair|eval
 void registerGraph(CLI::App& app);     // cmd_graph.cpp: drover graph optimize
 void registerFeatures(CLI::App& app);  // cmd_features.cpp: drover features detect|track
+void registerConfig(CLI::App& app);    // cmd_config.cpp: drover config import-lvi-sam
 // The two halves of `drover features`, each in its own file.
 void registerFeaturesDetect(CLI::App& features);  // cmd_features_detect.cpp
 void registerFeaturesTrack(CLI::App& features);   // cmd_features_track.cpp

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   drover::cli::registerLoop(app);
   drover::cli::registerGraph(app);
   drover::cli::registerFeatures(app);
+  drover::cli::registerConfig(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -134,6 +134,7 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .bind("gravity_roll_pitch", c.gravity_roll_pitch)
       .bind("deskew_refinements", c.deskew_refinements)
       .bind("degenerate_restart_sweeps", c.degenerate_restart_sweeps)
+      .bind("use_imu_orientation", c.initializer.use_orientation)
       .nested("layout", [&](YamlSection& s) { bindLayout(s, c.layout, e); })
       .nested("features", [&](YamlSection& s) { bindFeatures(s, c.features, f); })
       .nested("local_map", [&](YamlSection& s) { bindLocalMap(s, c.local_map); })

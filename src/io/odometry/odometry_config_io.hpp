@@ -3,7 +3,8 @@
 // (left out = the default in the component's Config, whose header gives its unit); an unknown key or a bad value is
 // an IoError naming the file, the line and the dotted key. Sections and keys:
 //   odometry: use_imu, deskew, min_points, imu_wait [s], lidar_sigma_position [m], lidar_sigma_rotation [rad],
-//             degenerate_sigma
+//             degenerate_sigma, use_imu_orientation (take a 9-axis unit's orientation at initialisation; false
+//             when it is not of the IMU's acc/gyro frame, as LIO-SAM's extrinsicRPY != extrinsicRot says)
 //     layout:       n_rings, vertical_fov_min_deg, vertical_fov_max_deg, columns, scan_period [s],
 //                   spin (ccw | cw), ring_source (elevation | order), order_top_down, min_range, max_range [m]
 //     features:     edge_threshold, surf_threshold (LIO-SAM edgeThreshold/surfThreshold), surf_leaf, edge_leaf,
