@@ -139,7 +139,13 @@ void runOdometry(const RunOptions& o) {
   pipeline::OdometryConfig config = o.config.empty() ? pipeline::OdometryConfig{} : io::loadOdometryConfig(o.config);
   if (o.no_imu) config.use_imu = false;
   if (o.no_loop) config.loop.enabled = false;
-  std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, datasetOptions(o));
+  const io::DatasetOptions dataset_options = datasetOptions(o);
+  std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, dataset_options);
+  // --no-lidar, or a platform whose dataset section loads no lidar (EuRoC): the VIS alone.
+  const bool no_lidar = o.no_lidar || !dataset_options.load_lidar;
+  if (no_lidar)
+    spdlog::info("fusing: camera + IMU, the VIS alone ({})",
+                 o.no_lidar ? "--no-lidar" : "the platform config loads no lidar");
   const io::GroundTruth& gt = reader->groundTruth();
   pipeline::LidarOdometry odometry(config, reader->calibration());
   spdlog::info("drover run: {} ({}) -> {}", reader->describe(), o.format, o.out);
@@ -164,7 +170,7 @@ void runOdometry(const RunOptions& o) {
     if (!vis) {
       vis = std::make_unique<RunVis>(o.config, reader->calibration(), config.preintegration);
       if (last_imu) vis->onImu(*last_imu);  // the first frame's interval starts at the sample before it
-      if (!o.no_lidar)
+      if (!no_lidar)
         odometry.setSweepListener([&vis](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
           vis->onSweep(t, T, p);
         });
@@ -185,14 +191,14 @@ void runOdometry(const RunOptions& o) {
     if (const auto* scan = std::get_if<LidarScan>(&*m))
       record.scan_times.push_back(scan->t + reader->calibration().lidar_time_offset);
     if (const auto* frame = std::get_if<CameraFrame>(&*m)) {
-      visFor().onFrame(*frame, o.no_lidar ? nullptr : &odometry);
+      visFor().onFrame(*frame, no_lidar ? nullptr : &odometry);
       continue;
     }
     if (const auto* sample = std::get_if<ImuSample>(&*m)) {
       last_imu = *sample;
       if (vis) vis->onImu(*sample);
     }
-    if (o.no_lidar) continue;
+    if (no_lidar) continue;
     std::vector<pipeline::ScanOutcome> outcomes = odometry.process(*m);
     if (vis)
       for (const pipeline::ScanOutcome& s : outcomes) vis->onLisState(s);
@@ -204,16 +210,18 @@ void runOdometry(const RunOptions& o) {
   if (o.max_frames > 0 && o.format == "kitti" && scans_read >= o.max_frames) record.end = "--max-frames reached";
   const int interrupted_by = stop.signal();  // a signal after the reading is done changes nothing
   if (interrupted_by) record.end = "interrupted by " + signalName(interrupted_by);
-  if (!o.no_lidar) keep(odometry.finish(), record);
+  if (!no_lidar) keep(odometry.finish(), record);
   showNotices(odometry, o, record);
-  checkSomethingWasDone(odometry.stats(), o, vis.get());
+  RunOptions ran = o;
+  ran.no_lidar = no_lidar;
+  checkSomethingWasDone(odometry.stats(), ran, vis.get());
   record.wall_s = progress.wallSeconds();
   record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
   // Only now, and as OUT.partial: a run that fails on its data leaves no folder behind, one killed while writing
   // leaves an earlier run in OUT whole.
   io::StagedFolder folder(o.out, runFolderRules());
   RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string()};
-  if (o.no_lidar) writeVisRunFolder(context, *vis, record);
+  if (ran.no_lidar) writeVisRunFolder(context, *vis, record);
   else writeRunFolder(context, odometry, record, vis.get());
   folder.publish();
   if (!interrupted_by) return;

@@ -100,11 +100,22 @@ DepthAssociationResult DepthAssociator::associate(Time t, const Eigen::Isometry3
   std::vector<Eigen::Vector3d> cell_point(cell_range.size());
   const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
   const Time window = static_cast<Time>(config_.window_s * 1e9);
+  // Only points that can be a feature's neighbour matter: those within the features' normalised bounding box
+  // widened by the neighbour angle (and never beyond LVI-SAM's view cut |x|, |y| <= 10 z). This skips the
+  // trigonometry for the ~80 % of the window's points outside the camera's view.
+  double max_x = 0, max_y = 0;
+  for (const Eigen::Vector2d& n : normalized) {
+    max_x = std::max(max_x, std::abs(n.x()));
+    max_y = std::max(max_y, std::abs(n.y()));
+  }
+  const double margin = std::tan(std::min(1.2, 2 * config_.neighbour_cells * res));
+  const double cut_x = std::min(10.0, (max_x + margin) / std::max(1e-3, 1 - max_x * margin));
+  const double cut_y = std::min(10.0, (max_y + margin) / std::max(1e-3, 1 - max_y * margin));
   for (const Sweep& sweep : sweeps_) {
     if (sweep.t > t || sweep.t < t - window) continue;
     for (const Eigen::Vector3d& pw : sweep.points_world) {
       const Eigen::Vector3d p = T_cam_world * pw;
-      if (p.z() <= 0 || std::abs(p.x()) > 10 * p.z() || std::abs(p.y()) > 10 * p.z()) continue;  // LVI-SAM's view cut
+      if (p.z() <= 0 || std::abs(p.x()) > cut_x * p.z() || std::abs(p.y()) > cut_y * p.z()) continue;
       const double azimuth = std::atan2(p.x(), p.z()), elevation = std::atan2(p.y(), std::hypot(p.x(), p.z()));
       const int col = static_cast<int>(std::floor((azimuth + std::numbers::pi / 2) / res));
       const int row = static_cast<int>(std::floor((elevation + std::numbers::pi / 2) / res));

@@ -1,0 +1,140 @@
+// `drover run` with a camera, end to end: the VIS alone (--no-lidar, visual-inertial initialisation) and beside the
+// LIS (initialised from it, lidar depth) on a simulated straight course that starts at rest and accelerates; and the
+// nearly still EuRoC snippet, on which the visual-inertial initialisation must refuse and say that it needs motion.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "io/trajectory_io.hpp"
+#include "support/cli.hpp"
+#include "support/shared_data.hpp"
+#include "support/temp_dir.hpp"
+
+namespace drover::test {
+namespace {
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+// A platform config with the Shi-Tomasi detector (SuperPoint costs ~0.4 s a frame on these cores).
+std::string shiTomasiConfig(const std::string& name, const fs::path& dir) {
+  std::ifstream in(std::string(DROVER_SOURCE_DIR) + "/config/" + name);
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string from = "type: superpoint ";
+  const auto at = yaml.find(from);
+  EXPECT_NE(at, std::string::npos) << name << " no longer names SuperPoint as its detector";
+  if (at != std::string::npos) yaml.replace(at, from.size(), "type: shi-tomasi ");
+  const fs::path out = dir / name;
+  writeText(out, yaml);
+  return out.string();
+}
+
+// Path length of the ground truth between two times [s] and the estimate's displacement over the same span.
+struct Displacement {
+  double truth = 0, estimate = 0;
+};
+Displacement displacement(const Trajectory& est, const Trajectory& gt) {
+  Displacement d;
+  if (est.size() < 2) return d;
+  auto at = [&gt](Time t) {
+    const StampedPose* best = &gt.front();
+    for (const StampedPose& p : gt)
+      if (std::abs(p.t - t) < std::abs(best->t - t)) best = &p;
+    return best->T_world_body.translation();
+  };
+  d.truth = (at(est.back().t) - at(est.front().t)).norm();
+  d.estimate = (est.back().T_world_body.translation() - est.front().T_world_body.translation()).norm();
+  return d;
+}
+
+class VisRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = std::make_unique<TempDir>();
+    sim_ = runDrover("sim -q --scenario straight --duration 7 --camera-rate 15 --out " + data().string());
+    if (sim_.exit_code != 0) return;
+    const std::string config = shiTomasiConfig("farm_sim.yaml", dir_->path());
+    const std::string base = "run " + data().string() + " --format sim --config " + config + " --no-loop";
+    vis_ = runDrover(base + " --no-lidar --out " + (*dir_ / "vis").string());
+    lvi_ = runDrover(base + " --out " + (*dir_ / "lvi").string());
+  }
+  static void TearDownTestSuite() { dir_.reset(); }
+  void SetUp() override { ASSERT_EQ(sim_.exit_code, 0) << sim_.output; }
+  static fs::path data() { return *dir_ / "straight"; }
+
+  static inline std::unique_ptr<TempDir> dir_;
+  static inline CliResult sim_, vis_, lvi_;
+};
+
+TEST_F(VisRun, NoLidarRunsTheVisAloneAndWritesItsTrajectoryAsTheRunsTrajectory) {
+  ASSERT_EQ(vis_.exit_code, 0) << vis_.output;
+  const Json r = readJson(*dir_ / "vis" / "report.json");
+  EXPECT_EQ(r["mode"], "camera+imu");
+  EXPECT_TRUE(r["vis"]["initialized"].get<bool>());
+  EXPECT_NE(r["vis"]["events"][0]["what"].get<std::string>().find("visual-inertial alignment"), std::string::npos);
+  const Trajectory est = io::readTum((*dir_ / "vis" / "trajectory_vis.tum").string());
+  EXPECT_EQ(est.size(), io::readTum((*dir_ / "vis" / "trajectory.tum").string()).size());
+  EXPECT_EQ(est.size(), r["vis"]["frames_estimated"].get<std::size_t>());
+  EXPECT_GT(est.size(), 40u);  // initialised within the first seconds of motion, one pose per frame after that
+  EXPECT_FALSE(fs::exists(*dir_ / "vis" / "map.pcd"));  // no lidar, no map
+}
+
+TEST_F(VisRun, TheVisAloneGetsTheMetricDisplacementWithinFivePercent) {
+  ASSERT_EQ(vis_.exit_code, 0) << vis_.output;
+  const Displacement d = displacement(io::readTum((*dir_ / "vis" / "trajectory_vis.tum").string()),
+                                      io::readTum((data() / "groundtruth.txt").string()));
+  ASSERT_GT(d.truth, 2.0);
+  EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.05) << d.estimate << " m estimated, " << d.truth << " m true";
+}
+
+TEST_F(VisRun, BesideTheLisTheVisStartsFromItAndUsesLidarDepth) {
+  ASSERT_EQ(lvi_.exit_code, 0) << lvi_.output;
+  const Json r = readJson(*dir_ / "lvi" / "report.json");
+  EXPECT_EQ(r["mode"], "lidar+imu+camera");
+  EXPECT_EQ(r["vis"]["events"][0]["what"], "initialised from the LIS");
+  EXPECT_GT(r["vis"]["mean"]["features_with_lidar_depth"].get<double>(), 20.0);
+  const Displacement d = displacement(io::readTum((*dir_ / "lvi" / "trajectory_vis.tum").string()),
+                                      io::readTum((data() / "groundtruth.txt").string()));
+  EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.03) << d.estimate << " m estimated, " << d.truth << " m true";
+  EXPECT_TRUE(fs::exists(*dir_ / "lvi" / "trajectory.tum"));  // the LIS's, as without a camera
+}
+
+TEST_F(VisRun, TheReportGivesPerFrameRecordsAndMillisecondsPerStage) {
+  ASSERT_EQ(vis_.exit_code, 0) << vis_.output;
+  const Json v = readJson(*dir_ / "vis" / "report.json")["vis"];
+  for (const char* stage : {"track", "depth", "solve", "marginalize", "total"})
+    EXPECT_TRUE(v["ms_per_frame"].contains(stage)) << stage;
+  EXPECT_EQ(v["frames"].size(), v["frames_in"].get<std::size_t>());
+  EXPECT_EQ(v["frame_columns"][0], "t");
+  EXPECT_GT(v["mean"]["tracked"].get<double>(), 30.0);
+  EXPECT_GT(v["keyframes"].get<int>(), 5);
+}
+
+TEST(VisRunRefuses, NoLidarWithNoCameraIsAnErrorBeforeAnyWork) {
+  TempDir dir;
+  const CliResult r = runDrover("run " + dir.path().string() + " --format sim --no-lidar --no-camera --out " +
+                                (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.output, "--no-lidar with --no-camera")) << r.output;
+}
+
+TEST(VisRunRefuses, TheStillEurocSnippetIsNotInitialisedAndTheRunSaysItNeedsMotion) {
+  const fs::path seq = sharedData("euroc/V1_01_easy_micro");
+  if (!fs::exists(seq)) GTEST_SKIP() << "needs ../shared/data/euroc/V1_01_easy_micro (not present)";
+  TempDir dir;
+  const std::string config = shiTomasiConfig("euroc.yaml", dir.path());
+  const CliResult r = runDrover("run " + seq.string() + " --format euroc --config " + config + " --no-lidar --out " +
+                                (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "did not initialise")) << r.output;
+  EXPECT_TRUE(contains(r.output, "need motion") || contains(r.output, "not enough motion")) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));  // no run folder for a run that produced no pose
+}
+
+}  // namespace
+}  // namespace drover::test
