@@ -20,6 +20,7 @@
 #include "io/dataset.hpp"
 #include "io/odometry/odometry_config_io.hpp"
 #include "pipeline/lidar_odometry.hpp"
+#include "visual/camera_model.hpp"
 
 namespace drover::cli {
 namespace {
@@ -133,6 +134,22 @@ void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o
         o.dataset, window, s.scans_in, s.scans_skipped_empty, s.scans_skipped_time, s.points_dropped));
 }
 
+// A camera without usable intrinsics (a bag whose platform config gives none): the VIS cannot run. Beside the LIS
+// that is one warning and the frames are ignored; for the VIS alone it is an error naming the config.
+bool cameraUsable(const Calibration& calibration, bool no_lidar, const RunOptions& o, bool& warned) {
+  const std::string why = visual::validateIntrinsics(calibration.camera);
+  if (why.empty()) return true;
+  const std::string where = o.config.empty() ? o.dataset : o.config;
+  if (no_lidar)
+    throw std::invalid_argument(where + ": the camera has no usable intrinsics (" + why +
+                                "): the VIS needs them (the platform config's calibration.camera section)");
+  if (!warned)
+    spdlog::warn("camera frames ignored, no VIS: the camera has no usable intrinsics ({}); give them in {}'s "
+                 "calibration.camera section", why, where);
+  warned = true;
+  return false;
+}
+
 void runOdometry(const RunOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
   checkOptions(o);
@@ -142,7 +159,7 @@ void runOdometry(const RunOptions& o) {
   const io::DatasetOptions dataset_options = datasetOptions(o);
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, dataset_options);
   // --no-lidar, or a platform whose dataset section loads no lidar (EuRoC): the VIS alone.
-  const bool no_lidar = o.no_lidar || !dataset_options.load_lidar;
+  const bool no_lidar = o.no_lidar || (!dataset_options.load_lidar && !o.no_camera);
   if (no_lidar)
     spdlog::info("fusing: camera + IMU, the VIS alone ({})",
                  o.no_lidar ? "--no-lidar" : "the platform config loads no lidar");
@@ -166,6 +183,7 @@ void runOdometry(const RunOptions& o) {
   StopOnSignal stop;           // SIGINT/SIGTERM: stop reading and write what was processed
   std::unique_ptr<RunVis> vis;  // made at the first camera frame (a dataset without images runs the LIS alone)
   std::optional<ImuSample> last_imu;
+  bool camera_warned = false;
   const auto visFor = [&]() -> RunVis& {
     if (!vis) {
       vis = std::make_unique<RunVis>(o.config, reader->calibration(), config.preintegration);
@@ -191,6 +209,7 @@ void runOdometry(const RunOptions& o) {
     if (const auto* scan = std::get_if<LidarScan>(&*m))
       record.scan_times.push_back(scan->t + reader->calibration().lidar_time_offset);
     if (const auto* frame = std::get_if<CameraFrame>(&*m)) {
+      if (!cameraUsable(reader->calibration(), no_lidar, o, camera_warned)) continue;
       visFor().onFrame(*frame, no_lidar ? nullptr : &odometry);
       continue;
     }

@@ -157,6 +157,44 @@ bool linearizeResidual(const ceres::CostFunction& cost, const ceres::LossFunctio
   return r.allFinite() && std::all_of(J.begin(), J.end(), [](const MatrixXd& m) { return m.allFinite(); });
 }
 
+// Eliminates first the dropped one-dimensional coordinates that no residual couples to another dropped coordinate
+// (a VIO window's inverse depths: each meets only frame states): their block of H is diagonal, so their Schur
+// complement is exact and costs O(m k^2) instead of the O(m^3) eigen-decomposition of the whole dropped block. A
+// coordinate whose diagonal is at the rounding level (nothing constrains it) is left out, as the pseudo-inverse
+// would. H and g are [dropped (m) | kept] on entry and are replaced by the reduced system, m by the dropped left.
+void eliminateDecoupledScalars(MatrixXd& H, VectorXd& g, int& m) {
+  if (m == 0) return;
+  const double floor = static_cast<double>(H.rows()) * std::numeric_limits<double>::epsilon() *
+                       std::max(H.diagonal().head(m).maxCoeff(), 0.0);
+  std::vector<int> scalar, rest;
+  for (int c = 0; c < m; ++c) {
+    bool decoupled = true;
+    for (int j = 0; j < m && decoupled; ++j) decoupled = j == c || H(c, j) == 0.0;
+    (decoupled ? scalar : rest).push_back(c);
+  }
+  if (scalar.empty()) return;
+  const int n = static_cast<int>(H.rows());
+  std::vector<int> keep = rest;  // the reduced system: the other dropped coordinates, then the kept ones
+  for (int c = m; c < n; ++c) keep.push_back(c);
+  const int r = static_cast<int>(keep.size());
+  MatrixXd Hr(r, r), C(r, static_cast<int>(scalar.size()));
+  VectorXd gr(r);
+  for (int a = 0; a < r; ++a) {
+    gr(a) = g(keep[a]);
+    for (int b = 0; b < r; ++b) Hr(a, b) = H(keep[a], keep[b]);
+  }
+  for (std::size_t s = 0; s < scalar.size(); ++s) {
+    const double h = H(scalar[s], scalar[s]);
+    const double inv_sqrt = h > floor ? 1.0 / std::sqrt(h) : 0.0;
+    for (int a = 0; a < r; ++a) C(a, static_cast<int>(s)) = H(keep[a], scalar[s]) * inv_sqrt;
+    if (inv_sqrt > 0.0) gr.noalias() -= C.col(static_cast<int>(s)) * (g(scalar[s]) * inv_sqrt);
+  }
+  Hr.noalias() -= C * C.transpose();  // H_rr - H_rs H_ss^-1 H_sr with H_ss diagonal
+  H = std::move(Hr);
+  g = std::move(gr);
+  m = static_cast<int>(rest.size());
+}
+
 MarginalResult failure(std::string reason) {
   MarginalResult out;
   out.reason = "marginalisation: " + std::move(reason);
@@ -211,6 +249,9 @@ MarginalResult SchurMarginalizer::marginalize(const std::set<const double*>& dro
       }
     }
   }
+
+  eliminateDecoupledScalars(H, g, m);
+  n = static_cast<int>(H.rows());
 
   // Schur complement with the pseudo-inverse H_mm^+ = D V S^+ V^T D (a dropped direction nothing constrains adds
   // nothing; Qin et al. 2018, Eq. 30).

@@ -46,11 +46,11 @@ struct VioConfig {
   // The prior on the oldest frame at initialisation (sigmas): from the LIS, and from visual-inertial alignment.
   double init_sigma_position_m = 0.01;   // [m] (holds the gauge)
   double lis_sigma_rotation_rad = 0.01;  // [rad]
-  double lis_sigma_velocity = 0.1;       // [m/s]
+  double lis_sigma_velocity = 0.5;       // [m/s] (weak: the seed is a finite difference; a tight one fixes its error)
   double lis_sigma_gyro_bias = 0.005;    // [rad/s]
   double lis_sigma_acc_bias = 0.1;       // [m/s^2]
   double align_sigma_rotation_rad = 0.03;  // [rad]
-  double align_sigma_velocity = 0.2;       // [m/s]
+  double align_sigma_velocity = 0.5;       // [m/s]
   double align_sigma_gyro_bias = 0.01;     // [rad/s]
   double align_sigma_acc_bias = 0.3;       // [m/s^2]
   // Visual-inertial alignment (no lidar): VINS-Mono's thresholds.

@@ -46,8 +46,8 @@ struct FeatureTrackerConfig {
   int clahe_tiles = 8;              // CLAHE tiles per side (VINS-Mono: 8x8)
   double dark_mean = 60;            // [grey levels] kWhenDark: CLAHE when the frame's mean is below this
   bool async_detection = false;     // run the detector in a worker thread (see above)
-  int detect_below = 0;             // detect only when fewer live tracks than this (0 = whenever below max_features,
-                                    // as VINS-Mono); the VIS's policy for a slow detector such as SuperPoint
+  int detect_below = 0;             // detect only when fewer live tracks than this (0, or >= max_features: whenever
+                                    // below max_features, as VINS-Mono); the VIS's policy for a slow detector
   std::string validate() const;     // empty = valid, else names the bad value
 };
 

@@ -360,12 +360,13 @@ TEST(RunCliErrors, AnUnknownOdometryKeyExitsWith2AndOneLineNamingFileLineAndKey)
   EXPECT_FALSE(fs::exists(dir / "o"));
 }
 
-TEST(RunCliErrors, ADatasetWithoutLidarExitsWith2SayingItHasNoLidarScans) {
+// (Without --no-camera the same dataset runs the VIS alone: tests/cli/test_run_vis_cli.cpp.)
+TEST(RunCliErrors, ADatasetWithoutLidarAndTheCameraTurnedOffExitsWith2SayingItHasNoLidarScans) {
   const fs::path euroc = sharedData("euroc/V1_01_easy_micro");
   DROVER_REQUIRE_SHARED(euroc);
   TempDir dir;
   const CliResult r = runDrover("run " + euroc.string() + " --format euroc --config " + config("euroc.yaml") +
-                                " --out " + (dir / "o").string());
+                                " --no-camera --out " + (dir / "o").string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   const std::vector<std::string> errors = errorLines(r.output);
   ASSERT_EQ(errors.size(), 1u) << r.output;

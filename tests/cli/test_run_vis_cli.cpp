@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -52,67 +51,61 @@ Displacement displacement(const Trajectory& est, const Trajectory& gt) {
   return d;
 }
 
-class VisRun : public ::testing::Test {
- protected:
-  static void SetUpTestSuite() {
-    dir_ = std::make_unique<TempDir>();
-    sim_ = runDrover("sim -q --scenario straight --duration 7 --camera-rate 15 --out " + data().string());
-    if (sim_.exit_code != 0) return;
-    const std::string config = shiTomasiConfig("farm_sim.yaml", dir_->path());
-    const std::string base = "run " + data().string() + " --format sim --config " + config + " --no-loop";
-    vis_ = runDrover(base + " --no-lidar --out " + (*dir_ / "vis").string());
-    lvi_ = runDrover(base + " --out " + (*dir_ / "lvi").string());
-  }
-  static void TearDownTestSuite() { dir_.reset(); }
-  void SetUp() override { ASSERT_EQ(sim_.exit_code, 0) << sim_.output; }
-  static fs::path data() { return *dir_ / "straight"; }
+// The simulated straight course (at rest for 2 s, then pulling away at 0.4 m/s^2): 7 s at 15 Hz.
+CliResult simulate(const TempDir& dir) {
+  return runDrover("sim -q --scenario straight --duration 7 --camera-rate 15 --out " + (dir / "straight").string());
+}
 
-  static inline std::unique_ptr<TempDir> dir_;
-  static inline CliResult sim_, vis_, lvi_;
-};
+std::string runArgs(const TempDir& dir) {
+  return "run " + (dir / "straight").string() + " --format sim --config " +
+         shiTomasiConfig("farm_sim.yaml", dir.path()) + " --no-loop";
+}
 
-TEST_F(VisRun, NoLidarRunsTheVisAloneAndWritesItsTrajectoryAsTheRunsTrajectory) {
-  ASSERT_EQ(vis_.exit_code, 0) << vis_.output;
-  const Json r = readJson(*dir_ / "vis" / "report.json");
+// One test per run (each test is its own process under ctest, so a shared fixture would simulate again anyway).
+TEST(VisRun, NoLidarRunsTheVisAloneAtMetricScaleAndWritesItsTrajectoryAndReport) {
+  TempDir dir;
+  const CliResult sim = simulate(dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const CliResult vis = runDrover(runArgs(dir) + " --no-lidar --out " + (dir / "vis").string());
+  ASSERT_EQ(vis.exit_code, 0) << vis.output;
+  const Json r = readJson(dir / "vis" / "report.json");
   EXPECT_EQ(r["mode"], "camera+imu");
-  EXPECT_TRUE(r["vis"]["initialized"].get<bool>());
-  EXPECT_NE(r["vis"]["events"][0]["what"].get<std::string>().find("visual-inertial alignment"), std::string::npos);
-  const Trajectory est = io::readTum((*dir_ / "vis" / "trajectory_vis.tum").string());
-  EXPECT_EQ(est.size(), io::readTum((*dir_ / "vis" / "trajectory.tum").string()).size());
-  EXPECT_EQ(est.size(), r["vis"]["frames_estimated"].get<std::size_t>());
-  EXPECT_GT(est.size(), 40u);  // initialised within the first seconds of motion, one pose per frame after that
-  EXPECT_FALSE(fs::exists(*dir_ / "vis" / "map.pcd"));  // no lidar, no map
-}
-
-TEST_F(VisRun, TheVisAloneGetsTheMetricDisplacementWithinFivePercent) {
-  ASSERT_EQ(vis_.exit_code, 0) << vis_.output;
-  const Displacement d = displacement(io::readTum((*dir_ / "vis" / "trajectory_vis.tum").string()),
-                                      io::readTum((data() / "groundtruth.txt").string()));
-  ASSERT_GT(d.truth, 2.0);
-  EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.05) << d.estimate << " m estimated, " << d.truth << " m true";
-}
-
-TEST_F(VisRun, BesideTheLisTheVisStartsFromItAndUsesLidarDepth) {
-  ASSERT_EQ(lvi_.exit_code, 0) << lvi_.output;
-  const Json r = readJson(*dir_ / "lvi" / "report.json");
-  EXPECT_EQ(r["mode"], "lidar+imu+camera");
-  EXPECT_EQ(r["vis"]["events"][0]["what"], "initialised from the LIS");
-  EXPECT_GT(r["vis"]["mean"]["features_with_lidar_depth"].get<double>(), 20.0);
-  const Displacement d = displacement(io::readTum((*dir_ / "lvi" / "trajectory_vis.tum").string()),
-                                      io::readTum((data() / "groundtruth.txt").string()));
-  EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.03) << d.estimate << " m estimated, " << d.truth << " m true";
-  EXPECT_TRUE(fs::exists(*dir_ / "lvi" / "trajectory.tum"));  // the LIS's, as without a camera
-}
-
-TEST_F(VisRun, TheReportGivesPerFrameRecordsAndMillisecondsPerStage) {
-  ASSERT_EQ(vis_.exit_code, 0) << vis_.output;
-  const Json v = readJson(*dir_ / "vis" / "report.json")["vis"];
+  const Json& v = r["vis"];
+  EXPECT_TRUE(v["initialized"].get<bool>());
+  EXPECT_NE(v["events"][0]["what"].get<std::string>().find("visual-inertial alignment"), std::string::npos);
+  // One pose per frame after the start, trajectory.tum the same; no lidar, no map.
+  const Trajectory est = io::readTum((dir / "vis" / "trajectory_vis.tum").string());
+  EXPECT_EQ(est.size(), io::readTum((dir / "vis" / "trajectory.tum").string()).size());
+  EXPECT_EQ(est.size(), v["frames_estimated"].get<std::size_t>());
+  EXPECT_GT(est.size(), 40u);
+  EXPECT_FALSE(std::filesystem::exists(dir / "vis" / "map.pcd"));
+  // The report: ms per stage, a compact record per frame, tracking and keyframe counts.
   for (const char* stage : {"track", "depth", "solve", "marginalize", "total"})
     EXPECT_TRUE(v["ms_per_frame"].contains(stage)) << stage;
   EXPECT_EQ(v["frames"].size(), v["frames_in"].get<std::size_t>());
   EXPECT_EQ(v["frame_columns"][0], "t");
   EXPECT_GT(v["mean"]["tracked"].get<double>(), 30.0);
   EXPECT_GT(v["keyframes"].get<int>(), 5);
+  // Metric scale from the IMU alone: the displacement since the start within 5 %.
+  const Displacement d = displacement(est, io::readTum((dir / "straight" / "groundtruth.txt").string()));
+  ASSERT_GT(d.truth, 2.0);
+  EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.05) << d.estimate << " m estimated, " << d.truth << " m true";
+}
+
+TEST(VisRun, BesideTheLisTheVisStartsFromItAndUsesLidarDepth) {
+  TempDir dir;
+  const CliResult sim = simulate(dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const CliResult lvi = runDrover(runArgs(dir) + " --out " + (dir / "lvi").string());
+  ASSERT_EQ(lvi.exit_code, 0) << lvi.output;
+  const Json r = readJson(dir / "lvi" / "report.json");
+  EXPECT_EQ(r["mode"], "lidar+imu+camera");
+  EXPECT_EQ(r["vis"]["events"][0]["what"], "initialised from the LIS");
+  EXPECT_GT(r["vis"]["mean"]["features_with_lidar_depth"].get<double>(), 20.0);
+  const Displacement d = displacement(io::readTum((dir / "lvi" / "trajectory_vis.tum").string()),
+                                      io::readTum((dir / "straight" / "groundtruth.txt").string()));
+  EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.03) << d.estimate << " m estimated, " << d.truth << " m true";
+  EXPECT_TRUE(std::filesystem::exists(dir / "lvi" / "trajectory.tum"));  // the LIS's, as without a camera
 }
 
 TEST(VisRunRefuses, NoLidarWithNoCameraIsAnErrorBeforeAnyWork) {

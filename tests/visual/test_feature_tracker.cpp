@@ -251,6 +251,31 @@ TEST(FeatureTracker, AsyncDetectionAddsPointsCarriedToTheCurrentFrame) {
   EXPECT_LT(percentile(errors, 1.0), 0.5);
 }
 
+// Detect-when-needed (the VIS's policy for SuperPoint): with detect_below the detector runs only when the live tracks
+// fall below it; on a texture sliding out of view, tracks are lost at the leading edge, so the detector runs on some
+// frames and not on others, and never while the count is at or above the threshold.
+TEST(FeatureTracker, DetectBelowRunsTheDetectorOnlyWhenTheLiveTracksFallBelowIt) {
+  const auto canvas = testing::texture(1400, 800, 5);
+  FeatureTrackerConfig config = baseConfig();
+  config.detect_below = 90;
+  FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(), config);
+  int detected = 0, skipped = 0;
+  std::size_t previous = 0;
+  for (int i = 0; i < 40; ++i) {
+    const TrackingResult r = tracker.track(i * kFrameNs, testing::view(canvas, {12.0 * i, 0}, kSize));
+    const int before = r.tracked;  // live tracks before replenishment
+    if (i > 0 && before >= config.detect_below) {
+      EXPECT_EQ(r.added, 0) << "frame " << i << ": " << before << " live tracks";
+      ++skipped;
+    }
+    if (r.added > 0) ++detected;
+    previous = r.features.size();
+  }
+  EXPECT_GT(detected, 1);
+  EXPECT_GT(skipped, 5);
+  EXPECT_GT(previous, 60u);
+}
+
 TEST(FeatureTracker, RejectsBadConfigImagesAndTimes) {
   FeatureTrackerConfig bad = baseConfig();
   bad.flow_window = 20;

@@ -1,0 +1,88 @@
+// The `vio:` section of a platform config: every key reaches VioConfig, an unknown key or a bad value is an error
+// naming the file, the line and the key, and the shipped configs load. (In tests/cli because that test module links
+// drover_io_visual.)
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "io/error.hpp"
+#include "io/visual/vio_config_io.hpp"
+#include "support/temp_dir.hpp"
+
+namespace drover::test {
+namespace {
+
+std::string write(const TempDir& dir, const std::string& yaml) {
+  const auto p = dir / "platform.yaml";
+  writeText(p, yaml);
+  return p.string();
+}
+
+TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
+  TempDir dir;
+  const vio::VioConfig c = io::loadVioConfig(write(dir, R"(vio:
+  window: 7
+  min_parallax_px: 12.5
+  sigma_px: 2.0
+  depth_mode: factor
+  depth_sigma_m: 0.1
+  max_solver_ms: 25
+  estimate_time_offset: true
+  time_offset_sigma_s: 0.002
+  init: visual
+  init_min_acc_excitation: 0.1
+  lis_sigma_rotation_rad: 0.02
+  max_imu_gap_s: 0.2
+  imu_midpoint: false
+)"));
+  EXPECT_EQ(c.window, 7);
+  EXPECT_DOUBLE_EQ(c.min_parallax_px, 12.5);
+  EXPECT_DOUBLE_EQ(c.sigma_px, 2.0);
+  EXPECT_EQ(c.depth_mode, vio::DepthMode::kFactor);
+  EXPECT_DOUBLE_EQ(c.depth_sigma_m, 0.1);
+  EXPECT_DOUBLE_EQ(c.max_solver_ms, 25);
+  EXPECT_TRUE(c.estimate_time_offset);
+  EXPECT_DOUBLE_EQ(c.time_offset_sigma_s, 0.002);
+  EXPECT_EQ(c.init, vio::InitMode::kVisual);
+  EXPECT_DOUBLE_EQ(c.init_min_acc_excitation, 0.1);
+  EXPECT_DOUBLE_EQ(c.lis_sigma_rotation_rad, 0.02);
+  EXPECT_DOUBLE_EQ(c.max_imu_gap_s, 0.2);
+  EXPECT_FALSE(c.imu_midpoint);
+}
+
+TEST(VioConfigIo, AFileWithoutTheSectionGivesTheDefaults) {
+  TempDir dir;
+  const vio::VioConfig c = io::loadVioConfig(write(dir, "odometry:\n  use_imu: true\n"));
+  EXPECT_EQ(c.window, vio::VioConfig{}.window);
+  EXPECT_EQ(c.depth_mode, vio::DepthMode::kFixed);
+}
+
+TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) {
+  TempDir dir;
+  for (const auto& [yaml, words] : std::vector<std::pair<std::string, std::string>>{
+           {"vio:\n  windw: 10\n", "vio.windw"},
+           {"vio:\n  depth_mode: sometimes\n", "vio.depth_mode"},
+           {"vio:\n  window: 2\n", "window must be in [3, 50]"},
+           {"vio:\n  sigma_px: -1\n", "sigma_px must be > 0"},
+           {"vio:\n  max_time_offset_s: nan\n", "vio.max_time_offset_s"}}) {
+    try {
+      io::loadVioConfig(write(dir, yaml));
+      ADD_FAILURE() << "accepted: " << yaml;
+    } catch (const io::IoError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("platform.yaml"), std::string::npos) << what;
+      EXPECT_NE(what.find("line"), std::string::npos) << what;
+      EXPECT_NE(what.find(words), std::string::npos) << what;
+    }
+  }
+}
+
+TEST(VioConfigIo, TheShippedConfigsLoad) {
+  for (const char* name : {"farm_sim.yaml", "euroc.yaml"}) {
+    const vio::VioConfig c = io::loadVioConfig(std::string(DROVER_SOURCE_DIR) + "/config/" + name);
+    EXPECT_EQ(c.validate(), "") << name;
+  }
+}
+
+}  // namespace
+}  // namespace drover::test
