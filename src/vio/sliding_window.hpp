@@ -25,6 +25,7 @@
 
 namespace drover::backend {
 class MarginalPriorFactor;
+class SchurMarginalizer;
 }
 
 namespace drover::vio {
@@ -98,6 +99,7 @@ class SlidingWindowEstimator {
   void removeOutliers(FrameResult& result);
   std::string failure(const FrameResult& previous_output) const;
   void slide(bool keyframe, FrameResult& result);
+  void declareWindowBlocks(backend::SchurMarginalizer& m);
   void marginalizeOldest();
   void marginalizeSecondNewest();
   void fixGauge(const Eigen::Isometry3d& T_world_imu0_before);

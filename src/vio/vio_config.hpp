@@ -35,7 +35,7 @@ struct VioConfig {
   double depth_sigma_m = 0.05;     // [m] factor mode: sigma of a lidar depth at 1 m with no spread ...
   double depth_sigma_rel = 0.02;   // ... plus this fraction of the depth ...
   double depth_sigma_spread = 0.5; // ... plus this fraction of the 3 lidar neighbours' range spread [m]
-  int max_iterations = 8;          // Ceres iterations per frame (VINS NUM_ITERATIONS)
+  int max_iterations = 5;          // Ceres iterations per frame (VINS NUM_ITERATIONS: 8 under a 40 ms limit)
   double max_solver_ms = 40;       // [ms] solver time limit per frame; only in live use (replay is deterministic)
   bool estimate_extrinsic = false; // refine T_imu_cam online (VINS ESTIMATE_EXTRINSIC 1)
   bool estimate_time_offset = true;  // estimate the camera-IMU time offset td (VINS ESTIMATE_TD)

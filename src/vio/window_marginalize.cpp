@@ -25,26 +25,22 @@ constexpr double kHeldDepthSigma = 1e-3;  // [m per m of depth]
 
 }  // namespace
 
-// Declares every block the window can put into a residual.
-static void declareBlocks(backend::SchurMarginalizer& m, const std::vector<double*>& frame_blocks_p,
-                          const std::vector<double*>& frame_blocks_q, const std::vector<double*>& frame_blocks_v,
-                          const std::vector<double*>& frame_blocks_b) {
-  for (std::size_t k = 0; k < frame_blocks_p.size(); ++k) {
-    m.addBlock(frame_blocks_p[k], 3, nullptr);
-    m.addBlock(frame_blocks_q[k], 4, &quaternionManifold());
-    m.addBlock(frame_blocks_v[k], 3, nullptr);
-    m.addBlock(frame_blocks_b[k], 6, nullptr);
+// Declares every frame, extrinsic and time-offset block the window can put into a residual.
+void SlidingWindowEstimator::declareWindowBlocks(backend::SchurMarginalizer& m) {
+  for (auto& f : frames_) {
+    m.addBlock(f->p, 3, nullptr);
+    m.addBlock(f->q, 4, &quaternionManifold());
+    m.addBlock(f->v, 3, nullptr);
+    m.addBlock(f->bias, 6, nullptr);
   }
+  m.addBlock(p_ic_, 3, nullptr);
+  m.addBlock(q_ic_, 4, &quaternionManifold());
+  m.addBlock(td_, 1, nullptr);
 }
 
 void SlidingWindowEstimator::marginalizeOldest() {
   backend::SchurMarginalizer m;
-  std::vector<double*> P, Q, V, B;
-  for (auto& f : frames_) P.push_back(f->p), Q.push_back(f->q), V.push_back(f->v), B.push_back(f->bias);
-  declareBlocks(m, P, Q, V, B);
-  m.addBlock(p_ic_, 3, nullptr);
-  m.addBlock(q_ic_, 4, &quaternionManifold());
-  m.addBlock(td_, 1, nullptr);
+  declareWindowBlocks(m);
   Residuals r;
   buildResiduals(r, true);
   for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
@@ -57,7 +53,8 @@ void SlidingWindowEstimator::marginalizeOldest() {
   std::size_t h = 0;
   for (auto& [id, f] : features_.features())
     if (r.fixed_depths.count(&f.inverse_depth)) m.addResidual(held[h++].get(), nullptr, {&f.inverse_depth});
-  std::set<const double*> drop{P[0], Q[0], V[0], B[0]};
+  const Frame& oldest = *frames_.front();
+  std::set<const double*> drop{oldest.p, oldest.q, oldest.v, oldest.bias};
   for (double* d : r.inverse_depths) drop.insert(d);
   backend::MarginalResult result = m.marginalize(drop);
   init_prior_.active = false;  // buildResiduals put it in r: it now lives on in the marginal prior
@@ -76,12 +73,7 @@ void SlidingWindowEstimator::marginalizeSecondNewest() {
     if (std::find(kept.begin(), kept.end(), b) != kept.end()) drop.insert(b);
   if (drop.empty()) return;
   backend::SchurMarginalizer m;
-  std::vector<double*> P, Q, V, B;
-  for (auto& fr : frames_) P.push_back(fr->p), Q.push_back(fr->q), V.push_back(fr->v), B.push_back(fr->bias);
-  declareBlocks(m, P, Q, V, B);
-  m.addBlock(p_ic_, 3, nullptr);
-  m.addBlock(q_ic_, 4, &quaternionManifold());
-  m.addBlock(td_, 1, nullptr);
+  declareWindowBlocks(m);
   m.addResidual(prior_.get(), nullptr, kept);
   backend::MarginalResult result = m.marginalize(drop);
   if (result.ok) prior_ = std::make_unique<backend::MarginalPriorFactor>(std::move(result));
