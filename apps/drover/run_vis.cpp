@@ -48,7 +48,21 @@ RunVis::RunVis(const std::string& config_path, const Calibration& calibration, c
   c.tracker = visual.tracker;
   c.depth = visual.depth;
   detector_name_ = visual::detectorTypeName(visual.detector.type);
-  std::shared_ptr<visual::KeypointDetector> detector = visual::makeDetector(visual.detector);
+  std::shared_ptr<visual::KeypointDetector> detector;
+  try {
+    detector = visual::makeDetector(visual.detector);
+  } catch (const std::invalid_argument& e) {
+    // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is
+    // relative to the working directory: a run must not fail for them. Shi-Tomasi is VINS-Mono's and LVI-SAM's own.
+    if (visual.detector.type != visual::DetectorType::kSuperPoint) throw;
+    const std::string what = e.what();
+    spdlog::warn("VIS: SuperPoint cannot start ({}): the VIS uses Shi-Tomasi instead (visual.detector.superpoint."
+                 "weights, or visual.detector.type)", what.substr(0, what.find(". ")));
+    visual::DetectorConfig fallback = visual.detector;
+    fallback.type = visual::DetectorType::kShiTomasi;
+    detector = visual::makeDetector(fallback);
+    detector_name_ = "shi-tomasi (SuperPoint unavailable)";
+  }
   vo_ = std::make_unique<vio::VisualOdometry>(c, calibration, imu, std::move(detector));
 }
 
