@@ -121,7 +121,8 @@ void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o
                                   ": drover run --no-lidar runs the VIS, which needs a camera and an IMU");
     if (vis->trajectory().empty())
       throw std::invalid_argument(fmt::format("{}: the VIS did not initialise in {} camera frames{}: {}", o.dataset,
-                                              vis->framesIn(), window, vis->report().value("not_initialized_because", "")));
+                                              vis->framesIn(), window,
+                                              vis->report().value("not_initialized_because", "")));
     return;
   }
   if (s.scans_in == 0)
@@ -264,7 +265,8 @@ void registerRun(CLI::App& app) {
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");
   cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera: the LIS alone (no VIS)");
-  cmd->add_flag("--no-lidar", o->no_lidar, "Ignore the lidar: the VIS alone (camera + IMU, visual-inertial initialisation)");
+  cmd->add_flag("--no-lidar", o->no_lidar,
+                "Ignore the lidar: the VIS alone (camera + IMU, visual-inertial initialisation)");
   addSeconds(cmd, "--start", o->start, atLeast(0, "s"), "Skip the first S seconds of the dataset");
   addSeconds(cmd, "--duration", o->duration, atLeast(0, "s"), "Process S seconds after --start (0 = to the end)");
   addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000,

@@ -10,9 +10,9 @@ namespace fs = std::filesystem;
 
 // Every file drover run writes into its folder (run_output.hpp; keep in step with it), and the report that
 // tools/course_report.py adds to it (scripts/run.sh), which describes the run it replaces.
-constexpr const char* kRunFiles[] = {"trajectory.tum", "trajectory_kitti.txt", "keyframes.tum",
-                                     "trajectory_imu_rate.tum", "trajectory_vis.tum", "map.pcd", "map.ply", "report.json", "ape.json",
-                                     "ape.png", "course_report.json"};
+constexpr const char* kRunFiles[] = {"trajectory.tum",  "trajectory_kitti.txt", "keyframes.tum",
+                                     "trajectory_imu_rate.tum", "trajectory_vis.tum", "map.pcd",
+                                     "map.ply", "report.json", "ape.json", "ape.png", "course_report.json"};
 
 bool isRunFile(const std::string& name) {
   for (const char* f : kRunFiles)

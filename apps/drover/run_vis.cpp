@@ -35,8 +35,8 @@ std::optional<Eigen::Isometry3d> lisPoseAt(const Trajectory& imu_rate, Time t) {
   return T;
 }
 
-constexpr std::size_t kMaxEvents = 200;
-constexpr std::size_t kLisStartSweeps = 20;  // sweeps the LIS gets to initialise its IMU before the VIS stops waiting  // report.json keeps the first events; the counters count them all
+constexpr std::size_t kMaxEvents = 200;  // report.json keeps the first events; the counters count them all
+constexpr std::size_t kLisStartSweeps = 20;  // sweeps the LIS gets to initialise its IMU before the VIS stops waiting
 
 }  // namespace
 

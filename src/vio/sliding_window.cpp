@@ -7,8 +7,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -142,7 +140,6 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
   const int index = static_cast<int>(frames_.size());
   const double parallax = features_.addFrame(index, features, td_[0]);
   result.tracked = features_.lastTracked();
-  if (std::getenv("VIO_DEBUG")) std::fprintf(stderr, "frame %d parallax %.2f px tracked %d\n", index, parallax * config_.focal_px, features_.lastTracked());
   const bool keyframe = index < 2 || parallax < 0 || result.tracked < config_.min_tracked_for_parallax ||
                         parallax * config_.focal_px >= config_.min_parallax_px;
   if (!frames_.empty()) {
@@ -208,8 +205,8 @@ void SlidingWindowEstimator::setInitPrior(double sigma_rotation, double sigma_ve
   std::copy(f.q, f.q + 4, init_prior_.q);
   std::copy(f.v, f.v + 3, init_prior_.v);
   std::copy(f.bias, f.bias + 6, init_prior_.bias);
-  init_prior_.sigma << Eigen::Vector3d::Constant(config_.init_sigma_position_m), Eigen::Vector3d::Constant(sigma_rotation),
-      Eigen::Vector3d::Constant(sigma_velocity), Eigen::Vector3d::Constant(sigma_gyro_bias),
+  init_prior_.sigma << Eigen::Vector3d::Constant(config_.init_sigma_position_m),
+      Eigen::Vector3d::Constant(sigma_rotation), Eigen::Vector3d::Constant(sigma_velocity), Eigen::Vector3d::Constant(sigma_gyro_bias),
       Eigen::Vector3d::Constant(sigma_acc_bias);
 }
 

@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "backend/imu_factors.hpp"
 #include "backend/quaternion_manifold.hpp"
@@ -91,10 +89,13 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
   for (auto& [id, f] : const_cast<FeatureManager&>(features_).features())
     if (features_.usable(f, newest, config_.min_observations) && f.depth > 0 && (!oldest_only || f.start() == 0))
       used.push_back(&f);
-  std::stable_sort(used.begin(), used.end(), [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
-  if (static_cast<int>(used.size()) > config_.max_features) used.resize(static_cast<std::size_t>(config_.max_features));
+  std::stable_sort(used.begin(), used.end(),
+                   [](const Feature* a, const Feature* b) { return a->obs.size() > b->obs.size(); });
+  if (static_cast<int>(used.size()) > config_.max_features)
+    used.resize(static_cast<std::size_t>(config_.max_features));
   if (!oldest_only && config_.estimate_time_offset)
-    r.items.push_back({std::make_unique<TimeOffsetPrior>(config_.time_offset_sigma_s), nullptr, {const_cast<double*>(td_)}});
+    r.items.push_back(
+        {std::make_unique<TimeOffsetPrior>(config_.time_offset_sigma_s), nullptr, {const_cast<double*>(td_)}});
   const double sqrt_info = focal_px_ / config_.sigma_px;
   double* p_ic = const_cast<double*>(p_ic_);
   double* q_ic = const_cast<double*>(q_ic_);
@@ -175,26 +176,12 @@ void SlidingWindowEstimator::optimize(FrameResult& result) {
 
   ceres::Solver::Options options;
   options.linear_solver_type = ceres::DENSE_SCHUR;
-  if (const char* ls = std::getenv("VIO_LS")) {
-    if (std::string(ls) == "sparse_schur") options.linear_solver_type = ceres::SPARSE_SCHUR;
-    if (std::string(ls) == "snc") options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-    if (std::string(ls) == "lm") options.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-  }
   options.trust_region_strategy_type = ceres::DOGLEG;
   options.max_num_iterations = config_.max_iterations;
   options.num_threads = 1;
   if (config_.max_solver_ms > 0 && !deterministic_) options.max_solver_time_in_seconds = config_.max_solver_ms * 1e-3;
   ceres::Solver::Summary summary;
-  const auto t_build = std::chrono::steady_clock::now();
   ceres::Solve(options, &problem, &summary);
-  if (std::getenv("VIO_PROFILE"))
-    std::fprintf(stderr, "td %.5f feats %d items %zu iters %zu cost %.3g->%.3g build %.2f pre %.2f min %.2f lin %.2f res %.2f jac %.2f post %.2f total %.2f\n",
-                 td_[0], r.features, r.items.size(), summary.iterations.size(), summary.initial_cost, summary.final_cost,
-                 std::chrono::duration<double, std::milli>(t_build - start).count(),
-                 summary.preprocessor_time_in_seconds * 1e3, summary.minimizer_time_in_seconds * 1e3,
-                 summary.linear_solver_time_in_seconds * 1e3, summary.residual_evaluation_time_in_seconds * 1e3,
-                 summary.jacobian_evaluation_time_in_seconds * 1e3, summary.postprocessor_time_in_seconds * 1e3,
-                 summary.total_time_in_seconds * 1e3);
   result.iterations = static_cast<int>(summary.iterations.size());
   solver_failed_ = summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost);
   result.features = r.features;
