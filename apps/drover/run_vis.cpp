@@ -36,6 +36,7 @@ std::optional<Eigen::Isometry3d> lisPoseAt(const Trajectory& imu_rate, Time t) {
 }
 
 constexpr std::size_t kMaxEvents = 200;  // report.json keeps the first events; the counters count them all
+constexpr std::size_t kShownResets = 20;  // reset warnings printed; the rest are counted
 constexpr std::size_t kLisStartSweeps = 20;  // sweeps the LIS gets to initialise its IMU before the VIS stops waiting
 
 }  // namespace
@@ -117,7 +118,8 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   const vio::FrameResult& r = f.estimate;
   if (r.reset) {
     ++resets_;
-    spdlog::warn("VIS reset at {:.3f} s: {}", toSeconds(r.t), r.event);
+    if (resets_ <= kShownResets) spdlog::warn("VIS reset at {:.3f} s: {}", toSeconds(r.t), r.event);
+    if (resets_ == kShownResets) spdlog::warn("VIS: further resets are counted in report.json, not shown");
     if (events_.size() < kMaxEvents) events_.push_back({r.t, "reset", r.event});
   } else if (r.just_initialized) {
     if (!first_init_) first_init_ = r.t;
