@@ -121,8 +121,7 @@ void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o
                                   ": drover run --no-lidar runs the VIS, which needs a camera and an IMU");
     if (vis->trajectory().empty())
       throw std::invalid_argument(fmt::format("{}: the VIS did not initialise in {} camera frames{}: {}", o.dataset,
-                                              vis->framesIn(), window,
-                                              vis->report().value("not_initialized_because", "")));
+                                              vis->framesIn(), window, vis->waitingReason()));
     return;
   }
   if (s.scans_in == 0)

@@ -43,6 +43,7 @@ class RunVis {
   // report.json's "vis" section (without the APE, which the caller adds).
   nlohmann::json report() const;
   std::size_t framesIn() const { return frames_in_; }
+  const std::string& waitingReason() const { return waiting_; }  // why the VIS has not initialised (the newest)
 
  private:
   std::optional<vio::SeedState> seedAt(Time t, const pipeline::LidarOdometry& lis) const;

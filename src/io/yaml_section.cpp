@@ -136,6 +136,15 @@ void YamlSection::apply(const YAML::Node& node) const {
   }
 }
 
+void checkSectionValid(const std::string& file, const YAML::Node& section_node, const std::string& section,
+                       const std::string& error) {
+  if (error.empty()) return;
+  const int line = section_node ? section_node.Mark().line : -1;
+  fail(file,
+       (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "section '" + section + "'",
+       error);
+}
+
 YAML::Node loadConfigRoot(const std::string& yaml_path) {
   if (!std::filesystem::exists(yaml_path)) fail(yaml_path, "", "config file not found");
   if (std::filesystem::is_directory(yaml_path))

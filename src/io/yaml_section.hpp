@@ -22,6 +22,11 @@ struct Range;
 // reader of a config section (dataset, sim, odometry, loop, visual).
 YAML::Node loadConfigRoot(const std::string& yaml_path);
 
+// A Config::validate() message as an IoError naming the file, the section's line (when the file has the section) and
+// the section; nothing when `error` is empty.
+void checkSectionValid(const std::string& file, const YAML::Node& section_node, const std::string& section,
+                       const std::string& error);
+
 class YamlSection {
  public:
   // `prefix` names the section in messages, e.g. "odometry.matcher".

@@ -2,8 +2,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "io/error.hpp"
-#include "io/text_parsing.hpp"
 #include "io/user_values.hpp"
 #include "io/yaml_section.hpp"
 
@@ -74,11 +72,7 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
   s.apply(node);
   c.depth_mode = parseDepthMode(depth_mode);
   c.init = parseInitMode(init);
-  if (const std::string err = c.validate(); !err.empty()) {
-    const int line = node ? node.Mark().line : -1;
-    fail(yaml_path, (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) +
-                        "section 'vio'", err);
-  }
+  checkSectionValid(yaml_path, node, "vio", c.validate());
   return c;
 }
 

@@ -98,16 +98,6 @@ visual::ClaheMode parseClahe(const std::string& name) {  // already checked by b
   return visual::ClaheMode::kWhenDark;
 }
 
-// A Config::validate() message, with the line of the sub-section it concerns when the file has one.
-void checkValid(const std::string& file, const YAML::Node& node, const std::string& section, const std::string& err) {
-  if (err.empty()) return;
-  const int line = node ? node.Mark().line : -1;
-  fail(
-      file,
-      (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "section '" + section + "'",
-      err);
-}
-
 }  // namespace
 
 VisualConfig loadVisualConfig(const std::string& yaml_path) {
@@ -127,12 +117,12 @@ VisualConfig loadVisualConfig(const std::string& yaml_path) {
   // Every detector's settings are checked, not only the chosen one's: a typo must not wait for a switch.
   const YAML::Node det = visual && visual.IsMap() ? visual["detector"] : YAML::Node();
   auto sub = [&](const char* key) { return det && det.IsMap() ? det[key] : YAML::Node(); };
-  checkValid(yaml_path, sub("shi_tomasi"), "visual.detector.shi_tomasi", c.detector.shi_tomasi.validate());
-  checkValid(yaml_path, sub("orb"), "visual.detector.orb", c.detector.orb.validate());
-  checkValid(yaml_path, sub("superpoint"), "visual.detector.superpoint", c.detector.superpoint.validate());
+  checkSectionValid(yaml_path, sub("shi_tomasi"), "visual.detector.shi_tomasi", c.detector.shi_tomasi.validate());
+  checkSectionValid(yaml_path, sub("orb"), "visual.detector.orb", c.detector.orb.validate());
+  checkSectionValid(yaml_path, sub("superpoint"), "visual.detector.superpoint", c.detector.superpoint.validate());
   auto section = [&](const char* key) { return visual && visual.IsMap() ? visual[key] : YAML::Node(); };
-  checkValid(yaml_path, section("tracker"), "visual.tracker", c.tracker.validate());
-  checkValid(yaml_path, section("depth"), "visual.depth", c.depth.validate());
+  checkSectionValid(yaml_path, section("tracker"), "visual.tracker", c.tracker.validate());
+  checkSectionValid(yaml_path, section("depth"), "visual.depth", c.depth.validate());
   return c;
 }
 
