@@ -1,3 +1,4 @@
+// Standalone cost probe of visual::DepthAssociator (not built by CMake; bench/RESULTS.md gives the two g++ lines).
 // Depth association cost: 5 s of VLP-16-like sweeps (50 x ~12k points in a 30 m box around the camera), 150 features.
 #include <chrono>
 #include <cstdio>

@@ -116,6 +116,15 @@ TEST(VisRunRefuses, NoLidarWithNoCameraIsAnErrorBeforeAnyWork) {
   EXPECT_TRUE(contains(r.output, "--no-lidar with --no-camera")) << r.output;
 }
 
+TEST(VisRunRefuses, NoLidarWithNoImuIsAnErrorBeforeAnyWork) {
+  TempDir dir;
+  const CliResult r = runDrover("run " + dir.path().string() + " --format sim --no-lidar --no-imu --out " +
+                                (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.output, "--no-lidar with --no-imu")) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
 TEST(VisRunRefuses, TheStillEurocSnippetIsNotInitialisedAndTheRunSaysItNeedsMotion) {
   const fs::path seq = sharedData("euroc/V1_01_easy_micro");
   if (!fs::exists(seq)) GTEST_SKIP() << "needs ../shared/data/euroc/V1_01_easy_micro (not present)";
