@@ -7,37 +7,15 @@
 
 #include "io/visual/visual_config_io.hpp"
 #include "io/visual/vio_config_io.hpp"
+#include "pipeline/lis_seed.hpp"
 
 namespace drover::cli {
 namespace {
 
 using Json = nlohmann::json;
 
-// T_world_imu of the LIS's IMU-rate odometry at t: interpolated between its samples, or its newest sample when t is
-// at most 20 ms past it (the camera frame can arrive before the IMU sample after it).
-std::optional<Eigen::Isometry3d> lisPoseAt(const Trajectory& imu_rate, Time t) {
-  if (imu_rate.empty() || t < imu_rate.front().t) return std::nullopt;
-  auto it = std::lower_bound(imu_rate.begin(), imu_rate.end(), t,
-                             [](const StampedPose& p, Time x) { return p.t < x; });
-  if (it == imu_rate.end()) {
-    if (t - imu_rate.back().t > 20'000'000) return std::nullopt;
-    return imu_rate.back().T_world_body;
-  }
-  if (it->t == t || it == imu_rate.begin()) return it->T_world_body;
-  const StampedPose& a = *std::prev(it);
-  const StampedPose& b = *it;
-  const double s = static_cast<double>(t - a.t) / static_cast<double>(b.t - a.t);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond(a.T_world_body.rotation())
-                   .slerp(s, Eigen::Quaterniond(b.T_world_body.rotation()))
-                   .toRotationMatrix();
-  T.translation() = (1 - s) * a.T_world_body.translation() + s * b.T_world_body.translation();
-  return T;
-}
-
 constexpr std::size_t kMaxEvents = 200;  // report.json keeps the first events; the counters count them all
 constexpr std::size_t kShownResets = 20;  // reset warnings printed; the rest are counted
-constexpr std::size_t kLisStartSweeps = 20;  // sweeps the LIS gets to initialise its IMU before the VIS stops waiting
 
 }  // namespace
 
@@ -82,17 +60,9 @@ void RunVis::onLisState(const pipeline::ScanOutcome& outcome) {
 // The LIS's state at a camera stamp: the IMU-rate pose, a velocity from the poses 40 ms apart (first order; the
 // window's IMU factors refine it), and the biases of its newest fused sweep.
 std::optional<vio::SeedState> RunVis::seedAt(Time t, const pipeline::LidarOdometry& lis) const {
-  if (!lis_state_ || !lis.stats().imu_initialized || lis.stats().scans_processed < 5) return std::nullopt;
-  const Trajectory& imu_rate = lis.imuRateTrajectory();
-  const std::optional<Eigen::Isometry3d> T = lisPoseAt(imu_rate, t);
-  const std::optional<Eigen::Isometry3d> T_before = lisPoseAt(imu_rate, t - 40'000'000);
-  if (!T || !T_before) return std::nullopt;
-  vio::SeedState s;
-  s.T_world_imu = *T;
-  s.v_world = (T->translation() - T_before->translation()) / 0.04;
-  s.bias.gyro = lis_state_->gyro_bias;
-  s.bias.acc = lis_state_->acc_bias;
-  return s;
+  if (!lis_state_ || !lis.stats().imu_initialized || lis.stats().scans_processed < pipeline::kLisSeedMinSweeps)
+    return std::nullopt;
+  return pipeline::lisSeedAt(lis.imuRateTrajectory(), t, imu::ImuBias{lis_state_->gyro_bias, lis_state_->acc_bias});
 }
 
 void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis) {
@@ -100,11 +70,12 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   vio::VisualOdometry::PoseAt pose_at;
   vio::Seeder seed;
   if (lis != nullptr) {
-    pose_at = [lis](Time t) { return lisPoseAt(lis->imuRateTrajectory(), t); };
+    pose_at = [lis](Time t) { return pipeline::lisPoseAt(lis->imuRateTrajectory(), t); };
     // The VIS waits for the LIS to seed it while the LIS can: it fuses the IMU, or is still starting (its first
     // sweeps). An LIS that gave the IMU up (lidar only) cannot seed: the VIS then aligns visually.
     const pipeline::OdometryStats& s = lis->stats();
-    const bool lis_can_seed = lis->config().use_imu && (s.imu_initialized || s.scans_processed < kLisStartSweeps);
+    const bool lis_can_seed =
+        lis->config().use_imu && (s.imu_initialized || s.scans_processed < pipeline::kLisStartSweeps);
     if (lis_can_seed) seed = [this, lis](Time t) { return seedAt(t, *lis); };
   }
   vio::VisFrame f;

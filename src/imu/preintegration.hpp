@@ -35,6 +35,12 @@ struct NavState {
   Eigen::Vector3d v_world = Eigen::Vector3d::Zero();              // [m/s], velocity of the IMU in the world
 };
 
+// An estimator's newest state with the bias it was estimated with (what a propagation starts from).
+struct FusedState {
+  NavState state;
+  ImuBias bias;
+};
+
 // Noise model of the IMU (continuous-time densities, Kalibr convention; names as LIO-SAM's imuAccNoise etc.).
 struct PreintegrationConfig {
   double gyro_noise_density = 1.7e-4;   // [rad/s/sqrt(Hz)]

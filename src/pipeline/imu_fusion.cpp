@@ -93,6 +93,11 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
   restart(state, smoother_.bias());
 }
 
+std::optional<imu::FusedState> ImuFusion::fusedState() const {
+  if (!initialized_ || !smoother_.initialized()) return std::nullopt;
+  return imu::FusedState{smoother_.state(), smoother_.bias()};
+}
+
 std::optional<lidar::SweepMotion> ImuFusion::sweepMotion(Time t0, Time t_end) const {
   if (!initialized_) return std::nullopt;
   return imuMotion(propagator_, T_imu_lidar_, t0, t_end);

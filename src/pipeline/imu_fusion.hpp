@@ -59,6 +59,9 @@ class ImuFusion {
   void reanchor(const Eigen::Isometry3d& T_new_old);
 
   imu::ImuStreamStats imuStats() const { return propagator_.stats(); }
+  // The smoother's newest fused state and bias (what the IMU-rate propagation starts from); nullopt before the
+  // smoother runs. The live system re-anchors its own IMU-rate propagation on it after every sweep.
+  std::optional<imu::FusedState> fusedState() const;
 
  private:
   void restart(const imu::NavState& state, const imu::ImuBias& bias);

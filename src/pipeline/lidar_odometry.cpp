@@ -52,6 +52,8 @@ struct LidarOdometry::Impl {
   int degenerate_run = 0;               // consecutive degenerate sweeps
   std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
   SweepListener sweep_listener;         // the VIS's lidar depth (setSweepListener)
+  KeyframeListener keyframe_listener;   // live: loop closure elsewhere, map updates (setKeyframeListener)
+  bool external_loops = false;
 
   Impl(const OdometryConfig& c, const Calibration& calib)
       : config(c),
@@ -84,6 +86,7 @@ struct LidarOdometry::Impl {
   void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
   void accumulateDegeneracy(const ScanOutcome& out);
   void applyLoopCorrection(ScanOutcome& out);
+  Eigen::Isometry3d correctKeyframes(const std::vector<Eigen::Isometry3d>& poses);
   void record(const ScanOutcome& out);
 };
 
@@ -124,6 +127,27 @@ Trajectory LidarOdometry::keyframeTrajectory() const {
 }
 
 void LidarOdometry::setSweepListener(SweepListener listener) { impl_->sweep_listener = std::move(listener); }
+
+void LidarOdometry::setKeyframeListener(KeyframeListener listener, bool external_loops) {
+  impl_->keyframe_listener = std::move(listener);
+  impl_->external_loops = external_loops;
+}
+
+void LidarOdometry::applyLoopCorrection(const LoopCorrection& c) {
+  Impl& m = *impl_;
+  if (c.poses.empty() || c.poses.size() > m.map.size())
+    throw std::invalid_argument(fmt::format("loop correction for {} keyframes, the map has {}", c.poses.size(),
+                                            m.map.size()));
+  // Keyframes made after the query (the loop was found while the LIS went on) move rigidly with it.
+  const std::size_t q = c.poses.size() - 1;
+  const Eigen::Isometry3d T_new_old_query = c.poses[q] * m.map.keyframe(q).T_world_lidar.inverse();
+  std::vector<Eigen::Isometry3d> poses = c.poses;
+  for (std::size_t i = q + 1; i < m.map.size(); ++i) poses.push_back(T_new_old_query * m.map.keyframe(i).T_world_lidar);
+  m.fusion.reanchor(m.correctKeyframes(poses));
+  m.stats.loop_times.push_back(c.event.t_query);
+}
+
+std::optional<imu::FusedState> LidarOdometry::fusedImuState() const { return impl_->fusion.fusedState(); }
 
 lidar::PointCloud LidarOdometry::mapCloud(float leaf) const {
   std::vector<std::size_t> all(impl_->map.size());
@@ -340,7 +364,12 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
   out.keyframe = true;
   ++stats.keyframes;
   const auto t0 = Clock::now();
-  const bool closed = loops.addKeyframe(map, index, degenerate_since_kf);
+  if (keyframe_listener) {
+    const Eigen::Isometry3d T_previous = index > 0 ? map.keyframe(index - 1).T_world_lidar : out.T_world_lidar;
+    keyframe_listener(KeyframeRecord{index, out.t, features, out.T_world_lidar,
+                                     T_previous.inverse() * out.T_world_lidar, degenerate_since_kf});
+  }
+  const bool closed = !external_loops && loops.addKeyframe(map, index, degenerate_since_kf);
   degenerate_since_kf.setZero();
   if (closed) applyLoopCorrection(out);
   out.ms.loop = msSince(t0);
@@ -360,20 +389,25 @@ void LidarOdometry::Impl::accumulateDegeneracy(const ScanOutcome& out) {
 // The graph moved the keyframes: the map, every sweep (through its keyframe), the current sweep and the IMU
 // smoother follow. T_new_old maps the newest keyframe's old pose onto its corrected one.
 void LidarOdometry::Impl::applyLoopCorrection(ScanOutcome& out) {
-  const std::vector<Eigen::Isometry3d> poses = loops.poses();
-  const std::size_t last = poses.size() - 1;
-  const Eigen::Isometry3d T_new_old = poses[last] * map.keyframe(last).T_world_lidar.inverse();
-  for (std::size_t i = 0; i < poses.size(); ++i) map.updatePose(i, poses[i]);
-  for (std::size_t i = 0; i < trajectory.size(); ++i)
-    trajectory[i].T_world_body = poses[anchors[i].keyframe] * anchors[i].T_kf_sweep;
-  out.T_world_lidar = poses[last];
-  T_world_lastkf = poses[last];
-  fusion.reanchor(T_new_old);
+  fusion.reanchor(correctKeyframes(loops.poses()));
+  out.T_world_lidar = T_world_lastkf;
   out.loop_closed = true;
   stats.loop_times.push_back(out.t);
   const LoopEvent& e = loops.events().back();
   out.note = fmt::format("loop closed with keyframe {} ({:.1f} s earlier): trajectory corrected by {:.2f} m",
                              e.candidate, toSeconds(e.t_query - e.t_candidate), e.correction);
+}
+
+// Moves every keyframe (all of them: poses.size() == map.size()) and every sweep through its keyframe; returns
+// T_new_old of the newest keyframe, which the IMU smoother follows.
+Eigen::Isometry3d LidarOdometry::Impl::correctKeyframes(const std::vector<Eigen::Isometry3d>& poses) {
+  const std::size_t last = poses.size() - 1;
+  const Eigen::Isometry3d T_new_old = poses[last] * map.keyframe(last).T_world_lidar.inverse();
+  for (std::size_t i = 0; i < poses.size(); ++i) map.updatePose(i, poses[i]);
+  for (std::size_t i = 0; i < trajectory.size(); ++i)
+    trajectory[i].T_world_body = poses[anchors[i].keyframe] * anchors[i].T_kf_sweep;
+  T_world_lastkf = poses[last];
+  return T_new_old;
 }
 
 void LidarOdometry::Impl::record(const ScanOutcome& out) {

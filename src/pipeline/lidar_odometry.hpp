@@ -84,6 +84,23 @@ struct OdometryStats {
   std::vector<std::string> notices;
 };
 
+// A keyframe as the LIS made it: for loop closure in another thread (pipeline::LoopWorker) and map updates.
+struct KeyframeRecord {
+  std::size_t index = 0;                                               // in the LIS's keyframe map
+  Time t = 0;                                                          // [ns]
+  lidar::FeatureSet features;                                          // lidar frame
+  Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();     // the LIS's estimate when it was made
+  Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();   // relative to the previous keyframe
+  geometry::Matrix6d degenerate_cov = geometry::Matrix6d::Zero();      // as LoopClosure::addKeyframe takes it
+};
+
+// Keyframe poses corrected by an accepted loop (LIO-SAM's correctPoses input): T_world_lidar of keyframes
+// 0 .. poses.size() - 1, the last being the loop's query.
+struct LoopCorrection {
+  std::vector<Eigen::Isometry3d> poses;
+  LoopEvent event;
+};
+
 class LidarOdometry {
  public:
   // Throws std::invalid_argument when the config is invalid (names the bad value).
@@ -118,6 +135,18 @@ class LidarOdometry {
   using SweepListener = std::function<void(Time t, const Eigen::Isometry3d& T_world_lidar,
                                            const std::vector<Eigen::Vector3f>& points_lidar)>;
   void setSweepListener(SweepListener listener);
+
+  // Live use (pipeline::System): every new keyframe goes to `listener`; with `external_loops` the in-line loop
+  // closure no longer runs (loopClosure() stays empty) and the loops come back through applyLoopCorrection. Set
+  // before the first measurement.
+  using KeyframeListener = std::function<void(const KeyframeRecord& keyframe)>;
+  void setKeyframeListener(KeyframeListener listener, bool external_loops);
+  // Moves the keyframes 0..n-1 onto the correction's poses and the keyframes made since its query rigidly with the
+  // query; the trajectory, the current local map and the IMU smoother follow (as after an in-line loop). Throws
+  // std::invalid_argument when the correction names more keyframes than the map has.
+  void applyLoopCorrection(const LoopCorrection& correction);
+  // The IMU smoother's newest fused state (IMU mode, once initialised): where the IMU-rate odometry starts from.
+  std::optional<imu::FusedState> fusedImuState() const;
 
  private:
   struct Impl;

@@ -1,0 +1,25 @@
+#include "pipeline/loop_worker.hpp"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace drover::pipeline {
+
+LoopWorker::LoopWorker(const LoopClosureConfig& loop, const lidar::LocalMapConfig& map) : map_(map), loops_(loop) {}
+
+std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
+  if (kf.index != map_.size())
+    throw std::invalid_argument(fmt::format("loop worker: keyframe {} given, {} expected", kf.index, map_.size()));
+  const Eigen::Isometry3d T_world_lidar =
+      kf.index == 0 ? kf.T_world_lidar : map_.keyframe(kf.index - 1).T_world_lidar * kf.T_previous_this;
+  map_.addKeyframe(kf.features, T_world_lidar);
+  if (!loops_.addKeyframe(map_, kf.index, kf.degenerate_cov)) return std::nullopt;
+  LoopCorrection c;
+  c.poses = loops_.poses();
+  for (std::size_t i = 0; i < c.poses.size(); ++i) map_.updatePose(i, c.poses[i]);
+  c.event = loops_.events().back();
+  return c;
+}
+
+}  // namespace drover::pipeline
