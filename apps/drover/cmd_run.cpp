@@ -15,9 +15,11 @@
 #include "apps/drover/commands.hpp"
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
+#include "apps/drover/run_realtime.hpp"
 #include "apps/drover/run_vis.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
+#include "io/odometry/live_config_io.hpp"
 #include "io/odometry/odometry_config_io.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "visual/camera_model.hpp"
@@ -29,7 +31,7 @@ using Clock = std::chrono::steady_clock;
 
 struct RunOptions {
   std::string dataset, format, config, out;
-  bool no_imu = false, no_camera = false, no_lidar = false, no_loop = false, quiet = false;
+  bool no_imu = false, no_camera = false, no_lidar = false, no_loop = false, quiet = false, realtime = false;
   double start = 0, duration = 0;  // [s] from the first measurement; duration 0 = to the end
   std::size_t max_frames = 0;      // KITTI odometry: first N frames only
 };
@@ -64,6 +66,7 @@ io::DatasetOptions datasetOptions(const RunOptions& o) {
   if (o.no_lidar) d.load_lidar = false;
   // Images are decoded only for the VIS, which is visual-inertial: not without an IMU (KITTI odometry has none).
   if (o.no_camera || o.no_imu || o.format == "kitti") d.load_images = false;
+  if (o.realtime) d.load_images = false;  // --realtime runs the LIS and the loop closure (see runRealtimeOdometry)
   d.kitti_max_frames = o.max_frames;
   return d;
 }
@@ -75,6 +78,9 @@ void checkOptions(const RunOptions& o) {
     throw std::invalid_argument("--no-lidar with --no-camera leaves nothing to run: drover run needs a lidar or a camera");
   if (o.no_lidar && o.no_imu)
     throw std::invalid_argument("--no-lidar with --no-imu: the VIS is visual-inertial and needs the IMU");
+  if (o.realtime && o.no_lidar)
+    throw std::invalid_argument("--realtime with --no-lidar: the real-time replay runs the LIS and loop closure; the "
+                                "VIS alone runs in the deterministic replay (drop --realtime)");
   io::StagedFolder::check(o.out, runFolderRules());  // before any work: a foreign or unusable --out costs nothing
 }
 
@@ -150,6 +156,34 @@ bool cameraUsable(const Calibration& calibration, bool no_lidar, const RunOption
   return false;
 }
 
+// --realtime: the dataset at sensor rate through pipeline::System (threads, bounded queues), then the same files.
+void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& config, io::Reader& reader) {
+  pipeline::SystemConfig system_config;
+  system_config.odometry = config;
+  if (!o.config.empty()) system_config.live = io::loadLiveConfig(o.config);
+  spdlog::info("drover run --realtime: {} ({}) at sensor rate -> {}", reader.describe(), o.format, o.out);
+  StopOnSignal stop;
+  RealtimeRun run = runRealtime(reader, system_config, RealtimeOptions{o.start, o.duration}, stop);
+  const pipeline::LidarOdometry& lis = run.system->lis();
+  for (const std::string& n : lis.stats().notices) spdlog::warn("{}", n);
+  checkSomethingWasDone(lis.stats(), o, nullptr);
+  io::StagedFolder folder(o.out, runFolderRules());
+  RunContext context{o.dataset, o.format, o.config, o.out, reader.calibration(), reader.groundTruth(),
+                     folder.dir().string()};
+  const LiveRun live{run.system->loopClosure(), run.realtime};
+  writeRunFolder(context, lis, run.record, nullptr, &live);
+  folder.publish();
+  const auto& l = run.realtime["latency_ms"];
+  spdlog::info("realtime: latency sweep end -> pose p50 {:.1f} / p95 {:.1f} / max {:.1f} ms; IMU sample -> pose p95 "
+               "{:.3f} ms; {} of {} sweeps dropped",
+               l["sweep"]["p50"].is_null() ? 0.0 : l["sweep"]["p50"].get<double>(),
+               l["sweep"]["p95"].is_null() ? 0.0 : l["sweep"]["p95"].get<double>(),
+               l["sweep"]["max"].is_null() ? 0.0 : l["sweep"]["max"].get<double>(),
+               l["imu_rate"]["p95"].is_null() ? 0.0 : l["imu_rate"]["p95"].get<double>(),
+               run.realtime["sweeps_dropped"].get<std::size_t>(), run.realtime["sweeps_pushed"].get<std::size_t>());
+  if (stop.requested()) throw ExitCode{128 + stop.signal()};
+}
+
 void runOdometry(const RunOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
   checkOptions(o);
@@ -158,6 +192,7 @@ void runOdometry(const RunOptions& o) {
   if (o.no_loop) config.loop.enabled = false;
   const io::DatasetOptions dataset_options = datasetOptions(o);
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, dataset_options);
+  if (o.realtime) return runRealtimeOdometry(o, config, *reader);
   // --no-lidar, or a platform whose dataset section loads no lidar (EuRoC): the VIS alone.
   const bool no_lidar = o.no_lidar || (!dataset_options.load_lidar && !o.no_camera);
   if (no_lidar)
@@ -270,6 +305,9 @@ void registerRun(CLI::App& app) {
   addSeconds(cmd, "--duration", o->duration, atLeast(0, "s"), "Process S seconds after --start (0 = to the end)");
   addInteger(cmd, "--max-frames", o->max_frames, 1, 1'000'000'000,
              "KITTI odometry: read only the first N >= 1 frames of times.txt");
+  cmd->add_flag("--realtime", o->realtime,
+                "Replay at sensor rate through the live system (threads, bounded queues: a slow stage drops sweeps); "
+                "report.json gains latency per output and the sweeps dropped. LIS and loop closure (no VIS)");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runOdometry(*o); });
 }

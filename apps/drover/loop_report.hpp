@@ -12,6 +12,7 @@
 
 namespace drover::cli {
 
-Json loopsJson(const RunContext& context, const pipeline::LidarOdometry& odometry);
+// loops: the LIS's own (odometry.loopClosure()) in the replay, the loop thread's in a --realtime run.
+Json loopsJson(const RunContext& context, const pipeline::LidarOdometry& odometry, const pipeline::LoopClosure& loops);
 
 }  // namespace drover::cli

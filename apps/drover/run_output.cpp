@@ -261,7 +261,7 @@ void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& 
 }
 
 void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r,
-                    const RunVis* vis) {
+                    const RunVis* vis, const LiveRun* live) {
   const Trajectory est = inBodyFrame(odometry.trajectory(), c);
   if (!est.empty()) {
     io::writeTum(inRun(c, "trajectory.tum"), est);
@@ -290,7 +290,9 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["counts"] = statsJson(s, r);
   report["timings"] = timingsJson(r);
   report["ape"] = evaluate(c, est);
-  report["loops"] = loopsJson(c, odometry);
+  const bool live_loops = live != nullptr && live->loops != nullptr;
+  report["loops"] = loopsJson(c, odometry, live_loops ? *live->loops : odometry.loopClosure());
+  if (live != nullptr) report["realtime"] = live->realtime;
   if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
   if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
   if (vis != nullptr) report["vis"] = writeVisTrajectory(c, *vis);

@@ -12,6 +12,8 @@
 //   map.pcd, map.ply      the keyframes' clouds in the world frame (binary)
 //   report.json           how the run ended, counts, per-stage timings, degenerate sweeps, resets, and the APE when there is ground truth
 //   ape.json, ape.png     APE (translation, SE(3)-aligned) against the ground truth, when there is one
+#include <nlohmann/json.hpp>
+
 #include <string>
 #include <vector>
 
@@ -45,11 +47,17 @@ struct RunRecord {
   std::string end = "end of data";
 };
 
+// A --realtime run (pipeline::System): its loop thread's loop closure and report.json's "realtime" section.
+struct LiveRun {
+  const pipeline::LoopClosure* loops = nullptr;
+  nlohmann::json realtime;
+};
+
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be
 // written.
-// vis: the VIS when it ran beside the LIS (nullptr otherwise).
+// vis: the VIS when it ran beside the LIS (nullptr otherwise); live: set for a --realtime run.
 void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, const RunRecord& record,
-                    const RunVis* vis);
+                    const RunVis* vis, const LiveRun* live = nullptr);
 // --no-lidar: the VIS alone (trajectory.tum, trajectory_vis.tum, report.json, ape.json/png).
 void writeVisRunFolder(const RunContext& context, const RunVis& vis, const RunRecord& record);
 

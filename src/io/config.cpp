@@ -187,12 +187,13 @@ DatasetOptions loadDatasetOptions(const std::string& yaml_path) {
   const YAML::Node root = loadConfigRoot(yaml_path);
   if (root.IsNull()) return {};  // an empty file: all defaults
   // Every module's section is known here, so a misspelt one ("odometri:") cannot be silently ignored.
-  static const std::vector<std::string> known = {"dataset", "calibration", "sim", "odometry", "loop", "visual", "vio"};
+  static const std::vector<std::string> known = {"dataset", "calibration", "sim", "odometry", "loop", "visual", "vio",
+                                                     "live"};
   for (const auto& kv : root) {
     const std::string name = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), name) == known.end())
       fail(yaml_path, lineRecord(static_cast<std::size_t>(kv.first.Mark().line + 1)) + ", section " + echo(name),
-           "unknown section (expected dataset, calibration, sim, odometry, loop, visual or vio)");
+           "unknown section (expected dataset, calibration, sim, odometry, loop, visual, vio or live)");
   }
   DatasetOptions options;
   readDataset(SectionReader(section(root, "dataset", yaml_path), "dataset", yaml_path), options);

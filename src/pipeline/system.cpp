@@ -300,7 +300,7 @@ void System::pushSweep(LidarScan scan) {
     std::lock_guard<std::mutex> lock(m.stats_mutex);
     ++m.stats.sweeps_pushed;
   }
-  if (m.lis_queue.push(std::move(scan), true, m.config.live.sweep_queue))
+  if (m.lis_queue.push(std::move(scan), true, static_cast<std::size_t>(m.config.live.sweep_queue)))
     m.countDrop(&SystemStats::sweeps_dropped, "the LIS", "sweep");
 }
 
@@ -311,7 +311,7 @@ void System::pushFrame(CameraFrame frame) {
     std::lock_guard<std::mutex> lock(m.stats_mutex);
     ++m.stats.frames_pushed;
   }
-  if (m.vis_queue.push(std::move(frame), true, m.config.live.frame_queue))
+  if (m.vis_queue.push(std::move(frame), true, static_cast<std::size_t>(m.config.live.frame_queue)))
     m.countDrop(&SystemStats::frames_dropped, "the VIS", "frame");
 }
 

@@ -34,8 +34,8 @@
 namespace drover::pipeline {
 
 struct LiveConfig {
-  std::size_t sweep_queue = 2;  // [sweeps] waiting for the LIS at most; a new one then drops the oldest
-  std::size_t frame_queue = 2;  // [frames] waiting for the VIS at most; likewise
+  int sweep_queue = 2;          // [sweeps] waiting for the LIS at most; a new one then drops the oldest
+  int frame_queue = 2;          // [frames] waiting for the VIS at most; likewise
   double loop_rate_hz = 1.0;    // [Hz] how often the loop thread searches the keyframes made since (LIO-SAM: 1)
   std::string validate() const;  // empty when valid
 };

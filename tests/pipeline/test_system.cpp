@@ -55,7 +55,7 @@ OdometryConfig simConfig() {
   return c;
 }
 
-SystemConfig liveConfig(std::size_t sweep_queue) {
+SystemConfig liveConfig(int sweep_queue) {
   SystemConfig c;
   c.odometry = simConfig();
   c.live.sweep_queue = sweep_queue;
