@@ -66,7 +66,6 @@ io::DatasetOptions datasetOptions(const RunOptions& o) {
   if (o.no_lidar) d.load_lidar = false;
   // Images are decoded only for the VIS, which is visual-inertial: not without an IMU (KITTI odometry has none).
   if (o.no_camera || o.no_imu || o.format == "kitti") d.load_images = false;
-  if (o.realtime) d.load_images = false;  // --realtime runs the LIS and the loop closure (see runRealtimeOdometry)
   d.kitti_max_frames = o.max_frames;
   return d;
 }
@@ -161,9 +160,20 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   pipeline::SystemConfig system_config;
   system_config.odometry = config;
   if (!o.config.empty()) system_config.live = io::loadLiveConfig(o.config);
+  RealtimeOptions options{o.start, o.duration, nullptr, nullptr};
+  std::unique_ptr<RunVis> vis;  // with images, an IMU and usable intrinsics: the VIS in its own thread
+  const bool camera = visual::validateIntrinsics(reader.calibration().camera).empty();
+  if (camera && !o.no_camera && !o.no_imu && o.format != "kitti") {
+    VisSetup setup = loadVisSetup(o.config);
+    system_config.vis = setup.config;
+    options.detector = setup.detector;
+    vis = std::make_unique<RunVis>(setup);
+    options.vis = vis.get();
+  }
   spdlog::info("drover run --realtime: {} ({}) at sensor rate -> {}", reader.describe(), o.format, o.out);
   StopOnSignal stop;
-  RealtimeRun run = runRealtime(reader, system_config, RealtimeOptions{o.start, o.duration}, stop);
+  RealtimeRun run = runRealtime(reader, system_config, options, stop);
+  if (vis && vis->framesIn() == 0) vis.reset();  // no camera frames came: no VIS files
   const pipeline::LidarOdometry& lis = run.system->lis();
   for (const std::string& n : lis.stats().notices) spdlog::warn("{}", n);
   checkSomethingWasDone(lis.stats(), o, nullptr);
@@ -171,7 +181,7 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   RunContext context{o.dataset, o.format, o.config, o.out, reader.calibration(), reader.groundTruth(),
                      folder.dir().string()};
   const LiveRun live{run.system->loopClosure(), run.realtime};
-  writeRunFolder(context, lis, run.record, nullptr, &live);
+  writeRunFolder(context, lis, run.record, vis.get(), &live);
   folder.publish();
   const auto& l = run.realtime["latency_ms"];
   spdlog::info("realtime: latency sweep end -> pose p50 {:.1f} / p95 {:.1f} / max {:.1f} ms; IMU sample -> pose p95 "
@@ -307,7 +317,7 @@ void registerRun(CLI::App& app) {
              "KITTI odometry: read only the first N >= 1 frames of times.txt");
   cmd->add_flag("--realtime", o->realtime,
                 "Replay at sensor rate through the live system (threads, bounded queues: a slow stage drops sweeps); "
-                "report.json gains latency per output and the sweeps dropped. LIS and loop closure (no VIS)");
+                "report.json gains latency per output and the sweeps dropped");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runOdometry(*o); });
 }

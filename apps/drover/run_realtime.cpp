@@ -75,7 +75,9 @@ class ReadAhead {
 Json percentiles(std::vector<double> v) {
   if (v.empty()) return Json{{"p50", nullptr}, {"p95", nullptr}, {"max", nullptr}, {"count", 0}};
   std::sort(v.begin(), v.end());
-  const auto at = [&](double q) { return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))]; };
+  const auto at = [&](double q) {
+    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
+  };
   return Json{{"p50", at(0.50)}, {"p95", at(0.95)}, {"max", v.back()}, {"count", v.size()}};
 }
 
@@ -126,7 +128,12 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
                  c.event.candidate, toSeconds(c.event.t_query - c.event.t_candidate), c.event.correction);
   };
   cb.warning = [](const std::string& w) { spdlog::warn("{}", w); };
-  run.system = std::make_unique<pipeline::System>(config, reader.calibration(), cb);
+  if (o.vis != nullptr)
+    cb.vis_frame = [&](const vio::VisFrame& f) {
+      std::lock_guard<std::mutex> lock(record_mutex);
+      o.vis->record(f);
+    };
+  run.system = std::make_unique<pipeline::System>(config, reader.calibration(), cb, o.detector);
   pipeline::System& system = *run.system;
   const Time lidar_offset = reader.calibration().lidar_time_offset;
 
@@ -192,6 +199,7 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
   const auto& scans = run.record.scans;
   run.record.data_s = scans.size() > 1 ? toSeconds(scans.back().t - scans.front().t) : 0.0;
   const pipeline::SystemStats s = system.stats();
+  if (o.vis != nullptr) o.vis->attach(system.vis(), s.frames_pushed, s.frames_bad);
   run.realtime = Json{{"latency_ms", {{"sweep", percentiles(lat.sweep_ms)}, {"imu_rate", percentiles(lat.imu_ms)}}},
                       {"first_sweep_ms", lat.first_sweep_ms},
                       {"sweeps_dropped", s.sweeps_dropped},

@@ -10,6 +10,7 @@
 
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
+#include "apps/drover/run_vis.hpp"
 #include "io/reader.hpp"
 #include "pipeline/system.hpp"
 
@@ -17,6 +18,8 @@ namespace drover::cli {
 
 struct RealtimeOptions {
   double start = 0, duration = 0;  // [s] as drover run's --start / --duration (duration 0 = to the end)
+  std::shared_ptr<visual::KeypointDetector> detector;  // the VIS's, with config.vis
+  RunVis* vis = nullptr;  // records the VIS's frames (with config.vis)
 };
 
 struct RealtimeRun {

@@ -19,17 +19,15 @@ constexpr std::size_t kShownResets = 20;  // reset warnings printed; the rest ar
 
 }  // namespace
 
-RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu) {
+VisSetup loadVisSetup(const std::string& config_path) {
   io::VisualConfig visual = config_path.empty() ? io::VisualConfig{} : io::loadVisualConfig(config_path);
-  vio_config_ = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
-  vio::VisConfig c;
-  c.vio = vio_config_;
-  c.tracker = visual.tracker;
-  c.depth = visual.depth;
-  detector_name_ = visual::detectorTypeName(visual.detector.type);
-  std::shared_ptr<visual::KeypointDetector> detector;
+  VisSetup setup;
+  setup.config.vio = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
+  setup.config.tracker = visual.tracker;
+  setup.config.depth = visual.depth;
+  setup.detector_name = visual::detectorTypeName(visual.detector.type);
   try {
-    detector = visual::makeDetector(visual.detector);
+    setup.detector = visual::makeDetector(visual.detector);
   } catch (const std::invalid_argument& e) {
     // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is
     // relative to the working directory: a run must not fail for them. Shi-Tomasi is VINS-Mono's and LVI-SAM's own.
@@ -39,18 +37,34 @@ RunVis::RunVis(const std::string& config_path, const Calibration& calibration, c
                  "weights, or visual.detector.type)", what.substr(0, what.find(". ")));
     visual::DetectorConfig fallback = visual.detector;
     fallback.type = visual::DetectorType::kShiTomasi;
-    detector = visual::makeDetector(fallback);
-    detector_name_ = "shi-tomasi (SuperPoint unavailable)";
+    setup.detector = visual::makeDetector(fallback);
+    setup.detector_name = "shi-tomasi (SuperPoint unavailable)";
   }
-  vo_ = std::make_unique<vio::VisualOdometry>(c, calibration, imu, std::move(detector));
+  return setup;
+}
+
+RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu) {
+  VisSetup setup = loadVisSetup(config_path);
+  detector_name_ = setup.detector_name;
+  vio_config_ = setup.config.vio;
+  own_ = std::make_unique<vio::VisualOdometry>(setup.config, calibration, imu, std::move(setup.detector));
+  vo_ = own_.get();
+}
+
+RunVis::RunVis(const VisSetup& setup) : detector_name_(setup.detector_name), vio_config_(setup.config.vio) {}
+
+void RunVis::attach(const vio::VisualOdometry* vo, std::size_t frames_in, std::size_t frames_bad) {
+  vo_ = vo;
+  frames_in_ = frames_in;
+  frames_bad_ = frames_bad;
 }
 
 RunVis::~RunVis() = default;
 
-void RunVis::onImu(const ImuSample& sample) { vo_->addImu(sample); }
+void RunVis::onImu(const ImuSample& sample) { own_->addImu(sample); }
 
 void RunVis::onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points) {
-  vo_->addSweep(t, T_world_lidar, points);
+  own_->addSweep(t, T_world_lidar, points);
 }
 
 void RunVis::onLisState(const pipeline::ScanOutcome& outcome) {
@@ -80,12 +94,16 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   }
   vio::VisFrame f;
   try {
-    f = vo_->addFrame(frame, pose_at, seed);
+    f = own_->addFrame(frame, pose_at, seed);
   } catch (const std::invalid_argument& e) {  // wrong size or type, a stamp not after the previous frame's
     if (++frames_bad_ <= 5) spdlog::warn("camera frame {} skipped: {}", frame.source, e.what());
     if (frames_bad_ == 5) spdlog::warn("camera: further skipped frames are counted, not shown");
     return;
   }
+  record(f);
+}
+
+void RunVis::record(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
   if (r.reset) {
     ++resets_;
@@ -101,7 +119,7 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   }
   if (r.initialized) trajectory_.push_back({r.t, r.T_world_imu});
   records_.push_back({r.t, r.initialized, r.keyframe, f.detected, f.front_tracked, r.features, r.with_lidar_depth,
-                      r.outliers, r.iterations, vo_->estimator().featuresInThreeOrMore(), f.ms});
+                      r.outliers, r.iterations, f.share_three, f.ms});
 }
 
 Json RunVis::report() const {
@@ -116,7 +134,7 @@ Json RunVis::report() const {
   if (first_init_) j["first_init_s"] = toSeconds(*first_init_);
   if (!first_init_) j["not_initialized_because"] = waiting_;
   j["resets"] = resets_;
-  j["time_offset_s"] = vo_->estimator().timeOffset();
+  j["time_offset_s"] = vo_ != nullptr ? vo_->estimator().timeOffset() : 0.0;
   Json events = Json::array();
   for (const Event& e : events_) events.push_back({{"t", toSeconds(e.t)}, {"kind", e.kind}, {"what", e.what}});
   j["events"] = events;

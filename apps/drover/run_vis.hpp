@@ -24,11 +24,26 @@ struct VisFrameRecord {
   vio::VisStageMs ms;
 };
 
+// The VIS's configuration and detector from a platform config.
+struct VisSetup {
+  vio::VisConfig config;
+  std::shared_ptr<visual::KeypointDetector> detector;
+  std::string detector_name;
+};
+// Reads the `visual:` and `vio:` sections (defaults without a config). SuperPoint whose weights cannot be loaded
+// falls back to Shi-Tomasi with a warning.
+VisSetup loadVisSetup(const std::string& config_path);
+
 class RunVis {
  public:
-  // Reads the `visual:` and `vio:` sections of the platform config (defaults without one).
+  // The replay: runs its own vio::VisualOdometry (onImu, onFrame, onSweep, onLisState).
   RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu);
+  // --realtime: the VisualOdometry runs in pipeline::System; record() each frame it took, and attach() it (after
+  // the System's shutdown) for the report.
+  explicit RunVis(const VisSetup& setup);
   ~RunVis();
+  void record(const vio::VisFrame& frame);
+  void attach(const vio::VisualOdometry* vo, std::size_t frames_in, std::size_t frames_bad);
 
   void onImu(const ImuSample& sample);
   // A camera frame; lis is the LIS when it runs (nullptr with --no-lidar). A bad image is a counted warning.
@@ -48,7 +63,8 @@ class RunVis {
  private:
   std::optional<vio::SeedState> seedAt(Time t, const pipeline::LidarOdometry& lis) const;
 
-  std::unique_ptr<vio::VisualOdometry> vo_;
+  std::unique_ptr<vio::VisualOdometry> own_;
+  const vio::VisualOdometry* vo_ = nullptr;  // own_, or the System's
   std::string detector_name_;
   vio::VioConfig vio_config_;
   Trajectory trajectory_;

@@ -84,8 +84,13 @@ struct System::Impl {
       : config(c), cb(std::move(callbacks)), lis(c.odometry, calibration), propagator(c.odometry.propagator) {
     if (std::string e = c.live.validate(); !e.empty()) throw std::invalid_argument("live config: " + e);
     if (c.odometry.loop.enabled) loops = std::make_unique<LoopWorker>(c.odometry.loop, c.odometry.local_map);
-    if (c.vis && detector)
-      vo = std::make_unique<vio::VisualOdometry>(*c.vis, calibration, c.odometry.preintegration, std::move(detector));
+    if (c.vis && detector) {
+      // Live, the detector runs in the tracker's worker thread (SuperPoint takes ~0.4 s a frame here): KLT tracks
+      // every frame meanwhile. The replay keeps it synchronous, hence deterministic.
+      vio::VisConfig vis = *c.vis;
+      vis.tracker.async_detection = true;
+      vo = std::make_unique<vio::VisualOdometry>(vis, calibration, c.odometry.preintegration, std::move(detector));
+    }
     lis.setKeyframeListener([this](const KeyframeRecord& k) { onKeyframe(k); }, loops != nullptr);
     if (vo)
       lis.setSweepListener([this](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {

@@ -11,7 +11,8 @@
 //     keyframe made since, in order (so the accepted loops are the replay's); the LIS applies a correction before
 //     its next measurement (LIO-SAM's correctPoses);
 //   - the VIS (vio::VisualOdometry) runs in its own thread with at most live.frame_queue frames waiting, fed the IMU,
-//     the LIS's deskewed sweeps (lidar depth) and its IMU-rate poses and state (initialisation).
+//     the LIS's deskewed sweeps (lidar depth) and its IMU-rate poses and state (initialisation); its detector runs
+//     asynchronously in the tracker's worker thread (KLT tracks every frame while SuperPoint works).
 // Outputs are callbacks, each called from the thread that produced it (a callback must be quick and thread-safe
 // with respect to the caller's own data). shutdown() stops the input, lets every stage finish what is queued, and
 // joins the threads; the destructor does it if the caller did not.

@@ -36,6 +36,7 @@ struct VisFrame {
   int front_added = 0;       // new features from the detector
   int depth_associated = 0;  // features with a lidar depth this frame
   bool detected = false;     // the detector ran on this frame
+  double share_three = 0;    // of the window's solved features, the share seen in >= 3 window frames
   VisStageMs ms;
 };
 

@@ -78,7 +78,8 @@ Trajectory replay(const Course& course, const OdometryConfig& config) {
 // As a sensor stream with a LIS that keeps up: before each sweep, the sweeps pushed so far have been processed
 // except the newest (which waits for the IMU to cover its end). Without this the test would push 16 s of data in
 // a few milliseconds, and the IMU-rate output, which starts at the LIS's first fused sweep, would have nothing left.
-void feedAsInRealTime(System& system, const std::vector<Measurement>& stream, const std::atomic<std::size_t>& processed) {
+void feedAsInRealTime(System& system, const std::vector<Measurement>& stream,
+                      const std::atomic<std::size_t>& processed) {
   std::size_t pushed = 0;
   for (const Measurement& m : stream) {
     if (std::holds_alternative<LidarScan>(m)) {
@@ -248,7 +249,8 @@ TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   for (std::size_t i = 0; i < a.size(); ++i)
     worst = std::max(worst, (a[i].T_world_body.translation() - b[i].T_world_body.translation()).norm());
   Trajectory lidar_truth;
-  for (const StampedPose& p : course.truth) lidar_truth.push_back({p.t, p.T_world_body * course.calibration.T_imu_lidar});
+  for (const StampedPose& p : course.truth)
+    lidar_truth.push_back({p.t, p.T_world_body * course.calibration.T_imu_lidar});
   eval::ApeOptions o;
   o.alignment = eval::Alignment::kSe3;
   const double ape_replay = eval::computeApe(lidar_truth, a, o).stats.rmse;
