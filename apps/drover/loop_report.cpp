@@ -76,8 +76,8 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
 }
 
 // Searched keyframes with a true revisit (see the header), and how many of them closed a correct loop.
-void recall(const pipeline::LidarOdometry& odometry, const TruthLookup& truth, const std::vector<bool>& closed_ok,
-            Json& j) {
+void recall(const pipeline::LidarOdometry& odometry, const pipeline::LoopClosure& loops, const TruthLookup& truth,
+            const std::vector<bool>& closed_ok, Json& j) {
   const Trajectory kfs = odometry.keyframeTrajectory();
   const Time min_age = fromSeconds(odometry.config().loop.min_age);
   std::vector<std::optional<Eigen::Vector3d>> p;
@@ -87,7 +87,7 @@ void recall(const pipeline::LidarOdometry& odometry, const TruthLookup& truth, c
   }
   std::size_t revisits = 0, found = 0;
   for (std::size_t q = 0; q < kfs.size(); ++q) {
-    if (!p[q] || !odometry.loopClosure().searched(q)) continue;
+    if (!p[q] || !loops.searched(q)) continue;
     bool revisit = false;
     for (std::size_t i = 0; i < q && !revisit && kfs[i].t <= kfs[q].t - min_age; ++i)
       revisit = p[i] && (*p[i] - *p[q]).norm() < kRevisitDistance;
@@ -101,8 +101,7 @@ void recall(const pipeline::LidarOdometry& odometry, const TruthLookup& truth, c
 
 }  // namespace
 
-Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry) {
-  const pipeline::LoopClosure& loops = odometry.loopClosure();
+Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, const pipeline::LoopClosure& loops) {
   const pipeline::LoopStats& s = loops.stats();
   const TruthLookup truth(c);
   Json j{{"enabled", loops.config().enabled},
@@ -137,7 +136,7 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry) {
   if (!truth.empty()) {
     j["precision"] = judged ? static_cast<double>(correct) / static_cast<double>(judged) : 1.0;
     j["correct"] = correct;
-    recall(odometry, truth, closed_ok, j);
+    recall(odometry, loops, truth, closed_ok, j);
     j["narrowed_equals_full_shift"] = compared ? static_cast<double>(same_shift) / static_cast<double>(compared) : 1.0;
     spdlog::info("loops: {} accepted of {} verified; against the ground truth precision {:.3f}, recall {:.3f}",
                  s.accepted, s.verified, j["precision"].get<double>(), j["recall"].get<double>());

@@ -12,6 +12,7 @@
 
 namespace drover::cli {
 
-Json loopsJson(const RunContext& context, const pipeline::LidarOdometry& odometry);
+// loops: the loop search that ran (the LIS's own, or pipeline::System's loop thread's).
+Json loopsJson(const RunContext& context, const pipeline::LidarOdometry& odometry, const pipeline::LoopClosure& loops);
 
 }  // namespace drover::cli

@@ -261,7 +261,7 @@ void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& 
 }
 
 void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r,
-                    const RunVis* vis) {
+                    const RunVis* vis, const pipeline::LoopClosure* loops) {
   const Trajectory est = inBodyFrame(odometry.trajectory(), c);
   if (!est.empty()) {
     io::writeTum(inRun(c, "trajectory.tum"), est);
@@ -290,7 +290,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["counts"] = statsJson(s, r);
   report["timings"] = timingsJson(r);
   report["ape"] = evaluate(c, est);
-  report["loops"] = loopsJson(c, odometry);
+  report["loops"] = loopsJson(c, odometry, loops != nullptr ? *loops : odometry.loopClosure());
   if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
   if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
   if (vis != nullptr) report["vis"] = writeVisTrajectory(c, *vis);

@@ -47,9 +47,10 @@ struct RunRecord {
 
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be
 // written.
-// vis: the VIS when it ran beside the LIS (nullptr otherwise).
+// vis: the VIS when it ran beside the LIS (nullptr otherwise). loops: the loop search when it ran away from the LIS
+// (pipeline::System's loop thread); nullptr = the LIS's own (odometry.loopClosure()).
 void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, const RunRecord& record,
-                    const RunVis* vis);
+                    const RunVis* vis, const pipeline::LoopClosure* loops = nullptr);
 // --no-lidar: the VIS alone (trajectory.tum, trajectory_vis.tum, report.json, ape.json/png).
 void writeVisRunFolder(const RunContext& context, const RunVis& vis, const RunRecord& record);
 

@@ -19,17 +19,15 @@ constexpr std::size_t kShownResets = 20;  // reset warnings printed; the rest ar
 
 }  // namespace
 
-RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu) {
+VisSetup loadVisSetup(const std::string& config_path) {
   io::VisualConfig visual = config_path.empty() ? io::VisualConfig{} : io::loadVisualConfig(config_path);
-  vio_config_ = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
-  vio::VisConfig c;
-  c.vio = vio_config_;
-  c.tracker = visual.tracker;
-  c.depth = visual.depth;
-  detector_name_ = visual::detectorTypeName(visual.detector.type);
-  std::shared_ptr<visual::KeypointDetector> detector;
+  VisSetup setup;
+  setup.config.vio = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
+  setup.config.tracker = visual.tracker;
+  setup.config.depth = visual.depth;
+  setup.detector_name = visual::detectorTypeName(visual.detector.type);
   try {
-    detector = visual::makeDetector(visual.detector);
+    setup.detector = visual::makeDetector(visual.detector);
   } catch (const std::invalid_argument& e) {
     // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is
     // relative to the working directory: a run must not fail for them. Shi-Tomasi is VINS-Mono's and LVI-SAM's own.
@@ -39,10 +37,17 @@ RunVis::RunVis(const std::string& config_path, const Calibration& calibration, c
                  "weights, or visual.detector.type)", what.substr(0, what.find(". ")));
     visual::DetectorConfig fallback = visual.detector;
     fallback.type = visual::DetectorType::kShiTomasi;
-    detector = visual::makeDetector(fallback);
-    detector_name_ = "shi-tomasi (SuperPoint unavailable)";
+    setup.detector = visual::makeDetector(fallback);
+    setup.detector_name = "shi-tomasi (SuperPoint unavailable)";
   }
-  vo_ = std::make_unique<vio::VisualOdometry>(c, calibration, imu, std::move(detector));
+  return setup;
+}
+
+RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu) {
+  VisSetup setup = loadVisSetup(config_path);
+  vio_config_ = setup.config.vio;
+  detector_name_ = setup.detector_name;
+  vo_ = std::make_unique<vio::VisualOdometry>(setup.config, calibration, imu, std::move(setup.detector));
 }
 
 RunVis::~RunVis() = default;

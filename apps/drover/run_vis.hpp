@@ -16,6 +16,15 @@
 
 namespace drover::cli {
 
+// The VIS's config and keypoint detector from the platform config's `visual:` and `vio:` sections (defaults
+// without one). A SuperPoint detector that cannot start (weights missing) falls back to Shi-Tomasi with a warning.
+struct VisSetup {
+  vio::VisConfig config;
+  std::shared_ptr<visual::KeypointDetector> detector;
+  std::string detector_name;
+};
+VisSetup loadVisSetup(const std::string& config_path);
+
 struct VisFrameRecord {
   Time t = 0;
   bool initialized = false, keyframe = false, detected = false;
