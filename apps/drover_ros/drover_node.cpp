@@ -72,15 +72,16 @@ DroverNode::DroverNode(::ros::NodeHandle nh, ::ros::NodeHandle pnh)
   callbacks.warning = [](const std::string& w) { ROS_WARN_STREAM("drover: " << w); };
   session_ = std::make_unique<live::LiveSession>(params_.live, callbacks);
   publishStatic();
-  save_srv_ = pnh_.advertiseService("save", &DroverNode::onSave, this);
-  reset_srv_ = pnh_.advertiseService("reset", &DroverNode::onReset, this);
+  subscribe();
   path_timer_ = nh_.createWallTimer(::ros::WallDuration(params_.path_period), [this](const ::ros::WallTimerEvent&) {
     publishView(false);
   });
   map_timer_ = nh_.createWallTimer(::ros::WallDuration(params_.map_period), [this](const ::ros::WallTimerEvent&) {
     publishView(true);
   });
-  subscribe();
+  // Last: a client that sees the services knows the node is subscribed.
+  save_srv_ = pnh_.advertiseService("save", &DroverNode::onSave, this);
+  reset_srv_ = pnh_.advertiseService("reset", &DroverNode::onReset, this);
 }
 
 DroverNode::~DroverNode() { finish("node destroyed"); }

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <stdexcept>
 #include <unordered_map>
@@ -66,7 +67,7 @@ struct LiveSession::Impl {
   cli::RunRecord record;
   std::vector<std::vector<Eigen::Vector3f>> keyframe_clouds;  // [m] lidar frame, by keyframe index
   std::size_t dropped = 0;
-  Clock::time_point started = Clock::now();
+  std::optional<Clock::time_point> first_sweep;  // report.json's wall_s runs from the first sweep's arrival
 
   Impl(const LiveOptions& o, LiveCallbacks c);
   void start();
@@ -137,7 +138,7 @@ void LiveSession::Impl::start() {
     record = cli::RunRecord{};
     keyframe_clouds.clear();
     dropped = 0;
-    started = Clock::now();
+    first_sweep.reset();
   }
   system = std::make_unique<pipeline::System>(config, platform.calibration, systemCallbacks(), detector);
 }
@@ -164,6 +165,7 @@ void LiveSession::pushSweep(LidarScan scan) {
     std::lock_guard<std::mutex> record_lock(impl_->record_mutex);
     // On the IMU clock, as trajectory times (drover run's scan_times).
     impl_->record.scan_times.push_back(scan.t + impl_->platform.calibration.lidar_time_offset);
+    if (!impl_->first_sweep) impl_->first_sweep = Clock::now();
   }
   impl_->system->pushSweep(std::move(scan));
 }
@@ -214,7 +216,7 @@ std::string LiveSession::save(const std::string& dir, const std::string& end) {
     std::lock_guard<std::mutex> lock(m.record_mutex);
     r = m.record;
     r.measurements_dropped = m.dropped;
-    wall_s = std::chrono::duration<double>(Clock::now() - m.started).count();
+    if (m.first_sweep) wall_s = std::chrono::duration<double>(Clock::now() - *m.first_sweep).count();
   }
   if (r.scans.empty())
     throw std::invalid_argument("nothing to save yet: no sweep has produced a pose (" + summary() + ")");
