@@ -176,11 +176,14 @@ void LiveSession::pushFrame(CameraFrame frame) {
 }
 
 void LiveSession::dropped(const std::string& notice) {
+  std::size_t n = 0;
   {
     std::lock_guard<std::mutex> lock(impl_->record_mutex);
-    ++impl_->dropped;
+    n = ++impl_->dropped;
   }
-  if (impl_->cb.warning) impl_->cb.warning(notice);
+  // A driver whose every message is unreadable must not flood the log: the first ten, then every hundredth.
+  if (impl_->cb.warning && (n <= 10 || n % 100 == 0))
+    impl_->cb.warning(fmt::format("{} ({} messages dropped so far)", notice, n));
 }
 
 LiveView LiveSession::view(float map_leaf) const {

@@ -81,7 +81,8 @@ class LiveSession {
   void pushImu(const ImuSample& sample);
   void pushSweep(LidarScan scan);
   void pushFrame(CameraFrame frame);
-  // Counts a message the caller could not decode (report.json's counts.measurements_dropped) and warns.
+  // Counts a message the caller could not decode (report.json's counts.measurements_dropped) and warns (the first
+  // ten, then every hundredth).
   void dropped(const std::string& notice);
 
   // The keyframe poses and loops now, and the map when map_leaf > 0 [m] (voxel leaf; assembled outside the
