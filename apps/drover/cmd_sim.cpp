@@ -1,5 +1,6 @@
-// drover sim: generate a simulated dataset (lidar, camera, IMU, ground truth) that `--format sim` reads back.
-// The simulation is in src/sim, the folder format in src/io/sim_dataset.hpp; this file parses, reports progress.
+// drover sim: generate a simulated dataset (lidar, camera, IMU, ground truth) that `--format sim` reads back, or
+// with --format bag a ROS1 bag that `--format bag` reads. The simulation is in src/sim, the folder format in
+// src/io/sim_dataset.hpp, the bag's topics in src/io/sim_bag.hpp; this file parses and reports progress.
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -15,8 +16,9 @@
 
 #include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
-#include "io/sim_dataset.hpp"
 #include "io/error.hpp"
+#include "io/sim_bag.hpp"
+#include "io/sim_dataset.hpp"
 #include "io/trajectory_io.hpp"
 #include "io/user_values.hpp"
 #include "sim/scenario.hpp"
@@ -91,7 +93,8 @@ void checkOptions(const SimOptions& o) {
     throw std::invalid_argument("--scenario: unknown scenario " + io::echo(o.scenario) +
                                 " (expected one of: " + joined(names) + ")");
   // Before any simulation: --force replaces only an earlier dataset (or an empty folder), never ".", "..", the
-  // home folder or a file.
+  // home folder or a file; with --format bag only an earlier bag, never a folder or another file.
+  if (o.format == "bag") return io::SimBagWriter::checkOutput(o.out, o.force);
   io::SimWriterOptions wo;
   wo.overwrite = o.force;
   io::SimDatasetWriter::checkOutput(o.out, wo);
@@ -117,6 +120,21 @@ class Progress {
   Clock::time_point wall_start_, last_print_;
 };
 
+void writeBag(const SimOptions& o, const sim::Simulator& simulator, Progress& progress, double sim_s) {
+  io::SimBagWriter writer(o.out, simulator.datasetDescription(), simulator.groundTruthStates(), o.force);
+  simulator.run([&](Measurement&& m) {
+    progress.update(measurementTime(m));
+    writer.add(std::move(m));
+  });
+  writer.finish();
+  const io::SimBagCounts& c = writer.counts();
+  const double wall = progress.wallSeconds(), mb = static_cast<double>(c.bytes) / 1e6;
+  spdlog::info("wrote {}: {} IMU samples, {} scans ({:.0f} points each), {} frames, {} ground-truth poses; {:.1f} MB "
+               "({:.2f} MB per simulated second); {:.1f} s simulated in {:.1f} s ({:.2f} sim-s/s)",
+               o.out, c.imu, c.lidar, c.lidar ? static_cast<double>(c.lidar_points) / c.lidar : 0.0, c.camera,
+               c.ground_truth, mb, mb / std::max(1e-9, sim_s), sim_s, wall, sim_s / std::max(1e-9, wall));
+}
+
 void runSim(const SimOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
   checkOptions(o);
@@ -136,17 +154,18 @@ void runSim(const SimOptions& o) {
                o.scenario, o.seed, toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime()),
                scenario.trajectory->pathLength(), expected.imu, expected.lidar, config.lidar.model, expected.camera,
                o.out);
+  Progress progress(scenario.trajectory->startTime(), scenario.trajectory->endTime());
+  const double sim_s = toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime());
+  if (o.format == "bag") return writeBag(o, simulator, progress, sim_s);
   io::SimWriterOptions wo;
   wo.overwrite = o.force;
   io::SimDatasetWriter writer(o.out, simulator.datasetDescription(), wo);
-  Progress progress(scenario.trajectory->startTime(), scenario.trajectory->endTime());
   simulator.run([&](Measurement&& m) {
     progress.update(measurementTime(m));
     writer.add(std::move(m));
   });
   writer.finish(simulator.groundTruth());
   const io::SimWriterCounts& c = writer.counts();
-  const double sim_s = toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime());
   const double wall = progress.wallSeconds();
   spdlog::info("wrote {}: {} IMU samples, {} scans ({:.0f} points each), {} frames; {:.1f} s simulated in {:.1f} s "
                "({:.2f} sim-s/s)",
@@ -160,7 +179,9 @@ void registerSim(CLI::App& app) {
   auto* cmd = app.add_subcommand("sim", "Generate a simulated dataset (lidar, camera, IMU, ground truth)");
   auto o = std::make_shared<SimOptions>();
   cmd->add_option("--scenario", o->scenario, "Scenario: " + joined(sim::scenarioNames()))->required();
-  cmd->add_option("--out", o->out, "Output folder (written as OUT.partial, renamed when complete)")->required();
+  cmd->add_option("--out", o->out,
+                  "Output folder, or bag file with --format bag (written as OUT.partial, renamed when complete)")
+      ->required();
   addSeed(cmd, "--seed", o->seed, "Random seed in [0, 2^64 - 1]: the same seed gives byte-identical output")
       ->default_str("1");
   addSeconds(cmd, "--duration", o->duration, between(0, io::kMaxSimDurationS, "s"),
@@ -174,12 +195,19 @@ void registerSim(CLI::App& app) {
         o->camera_rate = io::checkedRate(io::parseNumber(text, source), io::kMaxSimCameraRateHz, source);
       },
       "Camera frame rate [Hz], up to 60 (default 15 or the config's)");
-  cmd->add_option("--format", o->format, "Output format")->check(CLI::IsMember({"folder"}))->capture_default_str();
+  cmd->add_option("--format", o->format,
+                  "Output format: folder (Drover's layout), or bag: a ROS1 bag with LVI-SAM's topics /points_raw, "
+                  "/imu_raw, /camera/image_raw and the ground truth on /ground_truth (nav_msgs/Odometry of the IMU); "
+                  "read it with --config config/farm_sim_bag.yaml")
+      ->check(CLI::IsMember({"folder", "bag"}))
+      ->capture_default_str();
   cmd->add_option("--config", o->config, "Platform config with a sim: section (config/farm_sim.yaml)");
   cmd->add_option("--kitti-poses", o->kitti_poses, "kitti05-replay: KITTI poses file (default ../shared/data)");
   cmd->add_option("--kitti-times", o->kitti_times, "kitti05-replay: KITTI times.txt (default ../shared/data)");
   cmd->add_flag("--no-camera", o->no_camera, "Do not render camera images");
-  cmd->add_flag("--force", o->force, "Replace an existing output folder that holds an earlier simulated dataset");
+  cmd->add_flag("--force", o->force,
+                "Replace an existing output folder that holds an earlier simulated dataset (with --format bag: an "
+                "existing ROS bag)");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runSim(*o); });
 }

@@ -268,10 +268,31 @@ const std::vector<std::uint8_t>& BagFile::chunkData(const BagIndex& index, std::
   return chunk_buffer_;
 }
 
+namespace {
+std::string messageWhere(const BagIndex& index, const IndexEntry& entry) {
+  return "message record at offset " + std::to_string(entry.offset) + " of chunk " + std::to_string(entry.chunk) +
+         " " + at(index.chunks[entry.chunk].record_pos);
+}
+}  // namespace
+
+std::vector<std::uint8_t> BagFile::copyMessageData(const BagIndex& index, const IndexEntry& entry) {
+  const Chunk& chunk = index.chunks[entry.chunk];
+  if (chunk.compression != "none") {
+    const auto [data, size] = messageData(index, entry);
+    return {data, data + size};
+  }
+  const std::string where = messageWhere(index, entry);
+  if (entry.offset >= chunk.data_len) fail(path_, where, "offset lies outside its chunk");
+  auto [f, span] = readRecord(chunk.data_begin + entry.offset, where);
+  if (span.end() > chunk.data_begin + chunk.data_len) fail(path_, where, "record runs past the end of its chunk");
+  if (f.op() != Op::kMessageData) fail(path_, where, "index points at a record that is not message data");
+  if (f.u32("conn") != entry.conn) fail(path_, where, "message connection differs from the index");
+  return readData(span, where);
+}
+
 std::pair<const std::uint8_t*, std::size_t> BagFile::messageData(const BagIndex& index, const IndexEntry& entry) {
   const std::vector<std::uint8_t>& data = chunkData(index, entry.chunk);
-  const std::string where = "message record at offset " + std::to_string(entry.offset) + " of chunk " +
-                            std::to_string(entry.chunk) + " " + at(index.chunks[entry.chunk].record_pos);
+  const std::string where = messageWhere(index, entry);
   auto [f, span] = parseRecord(data.data(), data.size(), entry.offset, path_, where);
   if (f.op() != Op::kMessageData) fail(path_, where, "index points at a record that is not message data");
   if (f.u32("conn") != entry.conn) fail(path_, where, "message connection differs from the index");

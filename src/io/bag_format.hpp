@@ -100,6 +100,9 @@ class BagFile {
   // Data of the message data record `entry` points to, inside the cached decompressed chunk (valid until the
   // next call). Checks the record's op and connection against the index.
   std::pair<const std::uint8_t*, std::size_t> messageData(const BagIndex& index, const IndexEntry& entry);
+  // The same data, copied. From an uncompressed chunk only the record is read (not the chunk), so visiting a
+  // topic of small messages (the ground truth) up front reads a few hundred bytes per message, not the bag.
+  std::vector<std::uint8_t> copyMessageData(const BagIndex& index, const IndexEntry& entry);
 
  private:
   void read(std::uint64_t pos, void* out, std::size_t n, const std::string& what);

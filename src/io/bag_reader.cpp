@@ -48,7 +48,55 @@ BagReader::BagReader(const std::string& path, const DatasetOptions& options)
   topics_[kImage] = options.load_images ? options.image_topic : "";
   std::fill(std::begin(latest_), std::end(latest_), std::numeric_limits<Time>::min());
   last_returned_ = std::numeric_limits<Time>::min();
+  readGroundTruth();  // before selectConnections frees the full index
   selectConnections();
+}
+
+void BagReader::readGroundTruth() {
+  const std::string& topic = options_.ground_truth_topic;
+  if (topic.empty()) return;
+  std::set<std::uint32_t> conns;
+  for (const bag::Connection& c : index_.connections) {
+    if (c.topic != topic) continue;
+    if (c.type != ros::kOdometry)
+      fail(path_, "topic " + topic, "configured as the ground-truth topic but has type " + c.type + ", expected " +
+                                        std::string(ros::kOdometry));
+    if (c.md5sum != "*" && c.md5sum != ros::kOdometryMd5)
+      fail(path_, "topic " + topic, "message type " + c.type + " has md5sum " + c.md5sum + ", expected " +
+                                        std::string(ros::kOdometryMd5) + " (a different message definition)");
+    conns.insert(c.id);
+  }
+  if (conns.empty()) {
+    warnings_.push_back("ground-truth topic " + topic + " is not in the bag");
+    return;
+  }
+  std::uint32_t n = 0;
+  for (const bag::IndexEntry& e : index_.entries) {
+    if (!conns.count(e.conn)) continue;
+    const std::string where = "topic " + topic + " message " + std::to_string(n++) + ", bag time " + timeString(e.time);
+    const std::vector<std::uint8_t> data = file_->copyMessageData(index_, e);
+    ros::Odometry o;
+    try {
+      o = ros::decodeOdometry(data.data(), data.size());
+    } catch (const ros::MessageError& err) {
+      fail(path_, where, err.what());
+    }
+    if (o.child_frame_id != "imu" && o.child_frame_id != "lidar")
+      fail(path_, where, "child_frame_id '" + o.child_frame_id.substr(0, 40) +
+                             "' is neither imu nor lidar: the ground truth must be the IMU's or the lidar's pose");
+    if (ground_truth_.body_frame.empty()) ground_truth_.body_frame = o.child_frame_id;
+    if (o.child_frame_id != ground_truth_.body_frame)
+      fail(path_, where, "child_frame_id '" + o.child_frame_id + "' differs from the first message's '" +
+                             ground_truth_.body_frame + "'");
+    if (!o.T_frame_child.matrix().allFinite()) fail(path_, where, "pose is not finite");
+    Trajectory& poses = ground_truth_.poses;
+    if (!poses.empty() && o.t <= poses.back().t) {
+      dropMeasurement(path_ + " (" + where + "): dropped: ground-truth stamp " + timeString(o.t) +
+                      " is not after the previous one's " + timeString(poses.back().t));
+      continue;
+    }
+    poses.push_back({o.t, o.T_frame_child});
+  }
 }
 
 void BagReader::selectConnections() {
@@ -196,6 +244,9 @@ std::string BagReader::describe() const {
   for (int k = 0; k < kStreamCount; ++k)
     if (!topics_[k].empty()) s += std::string(" ") + kStreamNames[k] + " " + topics_[k] + " (" +
                                   std::to_string(total_[k]) + " msgs)";
+  if (!ground_truth_.poses.empty())
+    s += " ground truth " + options_.ground_truth_topic + " (" + std::to_string(ground_truth_.poses.size()) +
+         " poses of the " + ground_truth_.body_frame + ")";
   for (const std::string& w : warnings_) s += "; " + w;
   return s;
 }

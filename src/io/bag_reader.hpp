@@ -11,7 +11,10 @@
 // naming the message, rather than silently out of order. Memory stays bounded by the window's messages.
 //
 // Calibration comes from DatasetOptions::calibration (bags carry none); time offsets in it are not applied here.
-// Bags have no ground truth.
+// Ground truth: the nav_msgs/Odometry messages on DatasetOptions::ground_truth_topic (a simulated bag's, `drover
+// sim --format bag`), read up front: T_world_body at each header stamp, body_frame = the messages' child_frame_id,
+// which must be "imu" or "lidar" and the same in every message; a stamp not after the previous one is dropped with a
+// notice (drops()), a non-finite pose or another type on the topic is an IoError. No topic configured: none.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -63,6 +66,7 @@ class BagReader final : public Reader {
   };
 
   void selectConnections();
+  void readGroundTruth();
   void decodeNext();
   bool releasable() const;
   std::optional<Measurement> pop();  // nullopt: the popped measurement was dropped as late

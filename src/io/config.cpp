@@ -109,10 +109,12 @@ YAML::Node section(const YAML::Node& root, const char* name, const std::string& 
 
 void readDataset(const SectionReader& s, DatasetOptions& o) {
   s.rejectUnknownKeys(
-      {"lidar_topic", "imu_topic", "image_topic", "kitti_camera", "load_lidar", "load_imu", "load_images"});
+      {"lidar_topic", "imu_topic", "image_topic", "ground_truth_topic", "kitti_camera", "load_lidar", "load_imu",
+       "load_images"});
   s.read("lidar_topic", o.lidar_topic);
   s.read("imu_topic", o.imu_topic);
   s.read("image_topic", o.image_topic);
+  s.read("ground_truth_topic", o.ground_truth_topic);
   s.read("kitti_camera", o.kitti_camera, 0, 3);
   s.read("load_lidar", o.load_lidar);
   s.read("load_imu", o.load_imu);

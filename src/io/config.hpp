@@ -3,6 +3,7 @@
 //
 //   dataset:                     # what to read (all keys optional; defaults as in DatasetOptions)
 //     lidar_topic / imu_topic / image_topic: ROS1 bag topics (strings)
+//     ground_truth_topic: a bag's nav_msgs/Odometry ground truth (none when left out)
 //     kitti_camera: 0..3          KITTI image folder (image_0 .. image_3)
 //     load_lidar / load_imu / load_images: true | false
 //   calibration:                 # for sources without their own calibration (bags); all keys optional

@@ -20,6 +20,8 @@ struct DatasetOptions {
   std::string lidar_topic = "/points_raw";
   std::string imu_topic = "/imu_raw";
   std::string image_topic = "/camera/image_raw";
+  // nav_msgs/Odometry ground truth (T_world_body, body = its child_frame_id: imu or lidar); empty: none.
+  std::string ground_truth_topic;
   // Used for bags, which carry no calibration.
   Calibration calibration;
 };

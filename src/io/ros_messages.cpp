@@ -37,6 +37,30 @@ Header readHeader(WireReader& in) {
   return h;
 }
 
+Odometry decodeOdometry(const std::uint8_t* data, std::size_t size) {
+  WireReader in(data, size);
+  Odometry o;
+  const Header h = readHeader(in);
+  o.t = h.stamp;
+  o.frame_id = h.frame_id;
+  o.child_frame_id = in.string();
+  const Eigen::Vector3d p = readVector3(in);
+  const double qx = in.get<double>(), qy = in.get<double>(), qz = in.get<double>(), qw = in.get<double>();
+  in.take(36 * sizeof(double));  // pose covariance
+  o.linear = readVector3(in);
+  o.angular = readVector3(in);
+  in.take(36 * sizeof(double));  // twist covariance
+  Eigen::Quaterniond q(qw, qx, qy, qz);
+  if (q.coeffs().allFinite()) {
+    if (std::abs(q.norm() - 1.0) > 1e-3)
+      throw MessageError("pose orientation is not a unit quaternion (norm " + std::to_string(q.norm()) + ")");
+    q.normalize();
+  }
+  o.T_frame_child.linear() = q.toRotationMatrix();
+  o.T_frame_child.translation() = p;
+  return o;
+}
+
 ImuSample decodeImu(const std::uint8_t* data, std::size_t size) {
   WireReader in(data, size);
   ImuSample s;

@@ -2,6 +2,7 @@
 // Decoders of serialized ROS1 messages (the wire format: little-endian fields in declaration order; strings and
 // variable arrays prefixed by a uint32 length; fixed arrays not). Pure functions of the bytes: they throw
 // MessageError with what was wrong, and the bag reader adds the file, topic and message index.
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -23,6 +24,8 @@ inline constexpr std::string_view kImage = "sensor_msgs/Image";
 inline constexpr std::string_view kImageMd5 = "060021388200f6f0f447d0fcd9c64743";
 inline constexpr std::string_view kCompressedImage = "sensor_msgs/CompressedImage";
 inline constexpr std::string_view kCompressedImageMd5 = "8f7a12909da2c9d3332d540a0977563f";
+inline constexpr std::string_view kOdometry = "nav_msgs/Odometry";  // ground truth of simulated bags
+inline constexpr std::string_view kOdometryMd5 = "cd5e73d190d741a2f92e81eda573aca7";
 
 class MessageError : public std::runtime_error {
  public:
@@ -67,6 +70,19 @@ struct Header {
   std::string frame_id;
 };
 Header readHeader(WireReader& in);
+
+// nav_msgs/Odometry: the pose of child_frame_id in frame_id and the twist in child_frame_id (REP 105). The
+// covariances are not kept.
+struct Odometry {
+  Time t = 0;  // [ns] header stamp
+  std::string frame_id, child_frame_id;
+  Eigen::Isometry3d T_frame_child = Eigen::Isometry3d::Identity();  // [m]
+  Eigen::Vector3d linear = Eigen::Vector3d::Zero();   // [m/s] in child_frame_id
+  Eigen::Vector3d angular = Eigen::Vector3d::Zero();  // [rad/s] in child_frame_id
+};
+// Throws MessageError for a cut-off message or an orientation that is not a unit quaternion to within 1e-3 (it is
+// then normalized); a non-finite position or orientation is returned as it is (the caller decides).
+Odometry decodeOdometry(const std::uint8_t* data, std::size_t size);
 
 // sensor_msgs/Imu -> ImuSample at the header stamp. The orientation is kept only when the driver provides one
 // (orientation_covariance[0] != -1, REP 145) and it is a unit quaternion to within 1e-2 (drivers without an

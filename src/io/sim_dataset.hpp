@@ -98,6 +98,15 @@ struct SimScenarioInfo {
   std::vector<SimSegmentInfo> segments;
 };
 
+// One ground-truth sample of the simulated body (= IMU) with its exact twist, on the simulation's clock (the bag's
+// nav_msgs/Odometry; the folder's groundtruth.txt keeps the pose only).
+struct SimGroundTruthState {
+  Time t = 0;  // [ns]
+  Eigen::Isometry3d T_world_imu = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d v_imu = Eigen::Vector3d::Zero();      // [m/s] velocity in the IMU frame
+  Eigen::Vector3d omega_imu = Eigen::Vector3d::Zero();  // [rad/s] angular rate in the IMU frame
+};
+
 struct SimDatasetDescription {
   Calibration calibration;
   SimSensorInfo sensors;

@@ -116,6 +116,15 @@ Calibration Simulator::calibration() const {
 
 Trajectory Simulator::groundTruth() const { return scenario_.trajectory->sample(config_.ground_truth_rate_hz); }
 
+std::vector<io::SimGroundTruthState> Simulator::groundTruthStates() const {
+  std::vector<io::SimGroundTruthState> out;
+  for (const StampedPose& p : groundTruth()) {
+    const BodyState b = scenario_.trajectory->at(p.t);
+    out.push_back({p.t, p.T_world_body, b.T_world_body.linear().transpose() * b.v_world, b.omega_body});
+  }
+  return out;
+}
+
 std::vector<Time> Simulator::sweepStarts() const {
   std::vector<Time> t;
   if (!config_.enable_lidar) return t;

@@ -17,6 +17,7 @@
 
 namespace drover::io {
 struct SimDatasetDescription;  // io/sim_dataset.hpp (plain data; the sim library calls no io function)
+struct SimGroundTruthState;
 }
 
 namespace drover::sim {
@@ -51,6 +52,8 @@ class Simulator {
   Simulator(const Scenario& scenario, const SimulatorConfig& config, std::uint64_t seed);
   Calibration calibration() const;
   Trajectory groundTruth() const;  // T_world_imu at ground_truth_rate_hz
+  // The same samples with the exact twist (velocity and angular rate in the IMU frame), for nav_msgs/Odometry.
+  std::vector<io::SimGroundTruthState> groundTruthStates() const;
   // Generates everything in time order of the stamps (ties: IMU, then lidar, then camera). IMU samples come from
   // simulateImu over the whole trajectory; sweep k starts at start + k / lidar rate while its end is inside the
   // trajectory; frame k is exposed (mid-exposure) at start + exposure / 2 + k / camera rate while the exposure

@@ -38,7 +38,8 @@ std::string errorOf(const test::TempDir& dir, const std::string& text) {
 }
 
 TEST(OdometryConfigReader, EveryShippedConfigLoadsAndPassesValidation) {
-  for (const char* name : {"kitti.yaml", "kitti_raw.yaml", "m2dgr.yaml", "farm_sim.yaml", "euroc.yaml", "lvisam.yaml"}) {
+  for (const char* name :
+       {"kitti.yaml", "kitti_raw.yaml", "m2dgr.yaml", "farm_sim.yaml", "farm_sim_bag.yaml", "euroc.yaml", "lvisam.yaml"}) {
     SCOPED_TRACE(name);
     OdometryConfig c;
     ASSERT_NO_THROW(c = loadOdometryConfig(shipped(name)));

@@ -91,7 +91,7 @@ TEST(SimCli, BadArgumentsExitWithCode2) {
   const std::string out = " --out " + (dir / "x").string();
   EXPECT_EQ(runDrover("sim --scenario straight --duration -1" + out).exit_code, 2);
   EXPECT_EQ(runDrover("sim --scenario straight --lidar vlp8" + out).exit_code, 2);
-  EXPECT_EQ(runDrover("sim --scenario straight --format bag" + out).exit_code, 2);
+  EXPECT_EQ(runDrover("sim --scenario straight --format rosbag2" + out).exit_code, 2);
   EXPECT_EQ(runDrover("sim --scenario straight --camera-rate 500 --duration 1" + out).exit_code, 2);
   EXPECT_EQ(runDrover("sim --scenario straight").exit_code, 2);  // --out missing
   EXPECT_FALSE(fs::exists(dir / "x"));

@@ -70,6 +70,15 @@ TEST(FuzzCliOptions, Sim) {
       {"sim -q --scenario straight --duration 0.3 --no-camera --out {out}", kError, "{out}"},  // exists, no --force
       {"sim -q --scenario straight --duration 0.3 --no-camera --out {kitti}/times.txt", kError, "times.txt"},
       {"sim -q --scenario straight --duration 0.3 --no-camera --force --out {plain}", kError, "{plain}"},  // item 1
+      // --format bag: --out is a file; --force replaces only a ROS bag, never a folder or another file.
+      {"sim -q --scenario straight --duration 0.3 --no-camera --format bag --out {out}/s.bag", kOk, "",
+       {"{out}/s.bag"}},
+      {"sim -q --scenario straight --duration 0.3 --no-camera --format bag --out ''", kError, "--out"},
+      {"sim -q --scenario straight --duration 0.3 --no-camera --format bag --force --out {out}", kError, "{out}"},
+      {"sim -q --scenario straight --duration 0.3 --no-camera --format bag --force --out {kitti}/times.txt", kError,
+       "times.txt"},
+      {"sim -q --scenario straight --duration 0.3 --no-camera --format bag --out {kitti}/times.txt/s.bag", kError,
+       "s.bag"},
       {"sim -q --scenario kitti05-replay --duration 0.3 --no-camera --kitti-poses {out}/none.txt --kitti-times "
        "{traj}/times.txt --out {out}/ds",
        kError, "none.txt", ds},
