@@ -134,8 +134,10 @@ TEST(RosNodeEndToEnd, LiveOdometryOnAPlayedBagIsAsGoodAsTheOfflineRunAndSaveWrit
                                               << node.log();
   lidar.write(tmp / "live.tum");
   const double live_ape = apeRmse(gt, tmp / "live.tum", tmp / "live_ape.json");
-  // Within 10 % of the offline run's APE, with a floor of 2 mm: the offline APE on this course is about 1 cm, and
-  // a sweep whose IMU arrives a little later live can be deskewed with one more IMU sample.
+  // Within 10 % of the offline run's APE, with a floor of 2 mm. The LIS waits until the IMU covers a sweep, so the
+  // live threads feed it what the replay does and the poses come out the same (measured: equal APE, 7.229 mm); the
+  // floor is for a loaded machine, where the LIS may drop a waiting sweep (1 of 882 on an 88 s course at load 4.8 on
+  // 2 cores) and 10 % of a 7 mm APE would be under a millimetre.
   EXPECT_NEAR(live_ape, offline_ape, std::max(0.1 * offline_ape, 0.002))
       << "live " << live_ape << " m, offline " << offline_ape << " m";
   EXPECT_GT(imu.count(), 10 * sweeps) << "the IMU-rate odometry: 200 Hz against 10 Hz sweeps";
