@@ -25,6 +25,9 @@ extern "C" void onSignal(int signal) {
 
 int main(int argc, char** argv) {
   ::ros::init(argc, argv, "drover", ::ros::init_options::NoSigintHandler);
+  // Started here, not by the first NodeHandle: otherwise the last NodeHandle's end (a node that failed to start)
+  // shuts ROS down, and the error line below would go nowhere.
+  ::ros::start();
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   int code = 0;

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "apps/drover/run_folder.hpp"
@@ -114,6 +115,16 @@ TEST(RosNodeEndToEnd, LiveOdometryOnAPlayedBagIsAsGoodAsTheOfflineRunAndSaveWrit
   ::ros::init(argc, nullptr, "drover_e2e_probe", ::ros::init_options::NoSigintHandler);
   ASSERT_TRUE(waitFor([] { return ::ros::master::check(); }, 15s)) << "no master on port " << port << ":\n"
                                                                       << master.log();
+  // Bad parameters: the node exits 1 with one line naming the parameter.
+  for (const auto& [args, named] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+           {{DROVER_ROS_BINARY, "__name:=bad1"}, "~config is not set"},
+           {{DROVER_ROS_BINARY, "__name:=bad2", "_config:=" + kConfig, "_map_leaf:=-1.0"}, "~map_leaf"},
+           {{DROVER_ROS_BINARY, "__name:=bad3", "_config:=" + (tmp / "missing.yaml").string()}, "missing.yaml"}}) {
+    ChildGroup bad(args, tmp / "bad.log");
+    ASSERT_TRUE(bad.waitExit(15s)) << bad.log();
+    EXPECT_EQ(bad.exitCode(), 1) << bad.log();
+    EXPECT_TRUE(contains(bad.log(), named)) << bad.log();
+  }
   ChildGroup node({DROVER_ROS_BINARY, "__name:=drover", "_config:=" + kConfig, "_use_camera:=false",
                    "_save_dir:=" + saved.string(), "_save_on_exit:=true"},
                   tmp / "node.log");
