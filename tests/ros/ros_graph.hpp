@@ -61,6 +61,10 @@ class ChildGroup {
       ::setpgid(0, 0);                      // its own group: the kill reaches whatever it starts
       ::prctl(PR_SET_PDEATHSIG, SIGKILL);   // and the leader dies with the test, even a SIGKILLed one
       if (::getppid() != parent) ::_exit(127);
+      // An ignored signal stays ignored across exec (a test run from a background shell ignores SIGINT): the
+      // child must hear the SIGINT it is stopped with.
+      ::signal(SIGINT, SIG_DFL);
+      ::signal(SIGTERM, SIG_DFL);
       ::dup2(fd, 1);
       ::dup2(fd, 2);
       ::execve(program.c_str(), args.data(), environ);
