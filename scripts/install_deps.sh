@@ -11,6 +11,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libbz2-dev liblz4-dev
   python3-matplotlib python3-numpy python3-rosbag python3-roslz4 python3-onnx
+  libroscpp-dev libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libvisualization-msgs-dev libstd-srvs-dev
+  libtf2-ros-dev python3-rosmaster python3-roslaunch rosout
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

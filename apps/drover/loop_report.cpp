@@ -24,6 +24,7 @@ class TruthLookup {
   }
   bool empty() const { return poses_.empty(); }
   std::optional<Eigen::Isometry3d> lidarAt(Time t) const {
+    if (poses_.empty()) return std::nullopt;  // no ground truth (a bag without it, a live run): nothing to look up
     auto it = std::lower_bound(poses_.begin(), poses_.end(), t, [](const StampedPose& p, Time v) { return p.t < v; });
     if (it == poses_.end() || (it != poses_.begin() && t - std::prev(it)->t < it->t - t)) --it;
     if (it == poses_.end() || std::abs(it->t - t) > 20'000'000) return std::nullopt;

@@ -12,7 +12,7 @@
 
 namespace drover::cli {
 
-// loops: the LIS's own (odometry.loopClosure()) in the replay, the loop thread's in a --realtime run.
+// loops: the loop search that ran (the LIS's own, or pipeline::System's loop thread's).
 Json loopsJson(const RunContext& context, const pipeline::LidarOdometry& odometry, const pipeline::LoopClosure& loops);
 
 }  // namespace drover::cli

@@ -292,7 +292,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["ape"] = evaluate(c, est);
   const bool live_loops = live != nullptr && live->loops != nullptr;
   report["loops"] = loopsJson(c, odometry, live_loops ? *live->loops : odometry.loopClosure());
-  if (live != nullptr) report["realtime"] = live->realtime;
+  if (live != nullptr && !live->realtime.is_null()) report["realtime"] = live->realtime;
   if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
   if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
   if (vis != nullptr) report["vis"] = writeVisTrajectory(c, *vis);

@@ -63,6 +63,9 @@ struct System::Impl {
   std::size_t lis_sweeps = 0;
   bool lis_imu_initialized = false;
 
+  // Held by the LIS thread while it changes the LIS, and by the loop thread while it searches: inspect() takes both.
+  mutable std::mutex lis_state_mutex, loop_state_mutex;
+
   LiveQueue<Measurement> lis_queue;
   LiveQueue<VisItem> vis_queue;
   // Keyframes for the loop thread, and the newest correction for the LIS (a later one contains the earlier).
@@ -150,11 +153,21 @@ void System::Impl::onKeyframe(const KeyframeRecord& k) {
 
 void System::Impl::lisLoop() {
   while (std::optional<Measurement> m = lis_queue.pop()) {
-    applyCorrection();
-    publish(lis.process(*m));
+    std::vector<ScanOutcome> outcomes;
+    {
+      std::lock_guard<std::mutex> lock(lis_state_mutex);
+      applyCorrection();
+      outcomes = lis.process(*m);
+    }
+    publish(std::move(outcomes));
   }
-  applyCorrection();
-  publish(lis.finish());
+  std::vector<ScanOutcome> outcomes;
+  {
+    std::lock_guard<std::mutex> lock(lis_state_mutex);
+    applyCorrection();
+    outcomes = lis.finish();
+  }
+  publish(std::move(outcomes));
 }
 
 // Re-anchors the IMU front on the newest fused state, tells the VIS's board, calls back.
@@ -203,7 +216,11 @@ void System::Impl::loopLoop() {
       last = loop_stop;
     }
     for (const KeyframeRecord& k : batch) {
-      std::optional<LoopCorrection> c = loops->add(k);
+      std::optional<LoopCorrection> c;
+      {
+        std::lock_guard<std::mutex> lock(loop_state_mutex);
+        c = loops->add(k);
+      }
       if (!c) continue;
       if (cb.loop) cb.loop(*c);
       std::lock_guard<std::mutex> lock(loop_mutex);
@@ -269,7 +286,10 @@ void System::Impl::stop() {
   }
   loop_wake.notify_all();
   if (loop_thread.joinable()) loop_thread.join();
-  applyCorrection();
+  {
+    std::lock_guard<std::mutex> lock(lis_state_mutex);
+    applyCorrection();
+  }
   vis_queue.close();
   if (vis_thread.joinable()) vis_thread.join();
   joined = true;
@@ -327,6 +347,12 @@ void System::shutdown() {
 SystemStats System::stats() const {
   std::lock_guard<std::mutex> lock(impl_->stats_mutex);
   return impl_->stats;
+}
+
+void System::inspect(const std::function<void(const LidarOdometry&, const LoopClosure*)>& f) const {
+  std::lock_guard<std::mutex> lis_lock(impl_->lis_state_mutex);
+  std::lock_guard<std::mutex> loop_lock(impl_->loop_state_mutex);
+  f(impl_->lis, impl_->loops ? &impl_->loops->loopClosure() : nullptr);
 }
 
 const LidarOdometry& System::lis() const {

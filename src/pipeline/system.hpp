@@ -91,6 +91,11 @@ class System {
   void shutdown();
 
   SystemStats stats() const;
+  // Calls f with the LIS and the loop search's LoopClosure (nullptr when loop closure is off) while neither works:
+  // between two measurements of the LIS and two keyframes of the loop search, which wait meanwhile (input keeps
+  // queueing; a full sweep queue drops its oldest as usual, so f should be quick). For reading the state while the
+  // system runs (the ROS node's map, path and save service); after shutdown() it simply calls f.
+  void inspect(const std::function<void(const LidarOdometry& lis, const LoopClosure* loops)>& f) const;
   // After shutdown() only (the stages are idle then): for writing the run's files.
   const LidarOdometry& lis() const;
   const LoopClosure* loopClosure() const;       // the loop thread's; nullptr when loop closure is off
