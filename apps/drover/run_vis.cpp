@@ -68,6 +68,7 @@ void RunVis::onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::
 }
 
 void RunVis::onLisState(const pipeline::ScanOutcome& outcome) {
+  if (outcome.loop_closed) own_->onWorldCorrected(outcome.T_new_old);
   if (outcome.has_imu_state) lis_state_ = outcome;
 }
 

@@ -133,7 +133,7 @@ void LidarOdometry::setKeyframeListener(KeyframeListener listener, bool external
   impl_->external_loops = external_loops;
 }
 
-void LidarOdometry::applyLoopCorrection(const LoopCorrection& c) {
+Eigen::Isometry3d LidarOdometry::applyLoopCorrection(const LoopCorrection& c) {
   Impl& m = *impl_;
   if (c.poses.empty() || c.poses.size() > m.map.size())
     throw std::invalid_argument(fmt::format("loop correction for {} keyframes, the map has {}", c.poses.size(),
@@ -143,8 +143,10 @@ void LidarOdometry::applyLoopCorrection(const LoopCorrection& c) {
   const Eigen::Isometry3d T_new_old_query = c.poses[q] * m.map.keyframe(q).T_world_lidar.inverse();
   std::vector<Eigen::Isometry3d> poses = c.poses;
   for (std::size_t i = q + 1; i < m.map.size(); ++i) poses.push_back(T_new_old_query * m.map.keyframe(i).T_world_lidar);
-  m.fusion.reanchor(m.correctKeyframes(poses));
+  const Eigen::Isometry3d T_new_old = m.correctKeyframes(poses);
+  m.fusion.reanchor(T_new_old);
   m.stats.loop_times.push_back(c.event.t_query);
+  return T_new_old;
 }
 
 std::optional<imu::FusedState> LidarOdometry::fusedImuState() const { return impl_->fusion.fusedState(); }
@@ -389,7 +391,8 @@ void LidarOdometry::Impl::accumulateDegeneracy(const ScanOutcome& out) {
 // The graph moved the keyframes: the map, every sweep (through its keyframe), the current sweep and the IMU
 // smoother follow. T_new_old maps the newest keyframe's old pose onto its corrected one.
 void LidarOdometry::Impl::applyLoopCorrection(ScanOutcome& out) {
-  fusion.reanchor(correctKeyframes(loops.poses()));
+  out.T_new_old = correctKeyframes(loops.poses());
+  fusion.reanchor(out.T_new_old);
   out.T_world_lidar = T_world_lastkf;
   out.loop_closed = true;
   stats.loop_times.push_back(out.t);

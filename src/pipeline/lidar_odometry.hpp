@@ -55,6 +55,7 @@ struct ScanOutcome {
   Eigen::Vector3d v_world = Eigen::Vector3d::Zero(), gyro_bias = Eigen::Vector3d::Zero(),
                   acc_bias = Eigen::Vector3d::Zero();
   bool loop_closed = false;       // this sweep's keyframe closed a loop: the trajectory so far was corrected
+  Eigen::Isometry3d T_new_old = Eigen::Isometry3d::Identity();  // with loop_closed: how the newest keyframe moved
   std::string warning;            // one line when something was off with this sweep
   std::string note;               // one line of news (a loop closed), not a problem
   StageTimes ms;
@@ -144,7 +145,8 @@ class LidarOdometry {
   // Moves the keyframes 0..n-1 onto the correction's poses and the keyframes made since its query rigidly with the
   // query; the trajectory, the current local map and the IMU smoother follow (as after an in-line loop). Throws
   // std::invalid_argument when the correction names more keyframes than the map has.
-  void applyLoopCorrection(const LoopCorrection& correction);
+  // Returns T_new_old of the newest keyframe (what the IMU smoother and the VIS's lidar sweeps follow).
+  Eigen::Isometry3d applyLoopCorrection(const LoopCorrection& correction);
   // The IMU smoother's newest fused state (IMU mode, once initialised): where the IMU-rate odometry starts from.
   std::optional<imu::FusedState> fusedImuState() const;
 

@@ -33,7 +33,11 @@ struct DepthSweep {
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();
   std::vector<Eigen::Vector3f> points_lidar;
 };
-using VisItem = std::variant<ImuSample, CameraFrame, DepthSweep>;
+// A loop correction moved the LIS's world: the VIS's buffered sweeps follow.
+struct WorldCorrection {
+  Eigen::Isometry3d T_new_old = Eigen::Isometry3d::Identity();
+};
+using VisItem = std::variant<ImuSample, CameraFrame, DepthSweep, WorldCorrection>;
 
 }  // namespace
 
@@ -198,7 +202,8 @@ void System::Impl::applyCorrection() {
     has_correction = false;
   }
   if (!c) return;
-  lis.applyLoopCorrection(*c);
+  const Eigen::Isometry3d T_new_old = lis.applyLoopCorrection(*c);
+  if (vo) vis_queue.push(WorldCorrection{T_new_old}, false, 0);
   std::lock_guard<std::mutex> lock(stats_mutex);
   ++stats.loops_applied;
 }
@@ -235,6 +240,7 @@ void System::Impl::visLoop() {
   while (std::optional<VisItem> item = vis_queue.pop()) {
     if (const auto* s = std::get_if<ImuSample>(&*item)) vo->addImu(*s);
     else if (const auto* d = std::get_if<DepthSweep>(&*item)) vo->addSweep(d->t, d->T_world_lidar, d->points_lidar);
+    else if (const auto* w = std::get_if<WorldCorrection>(&*item)) vo->onWorldCorrected(w->T_new_old);
     else visFrame(std::get<CameraFrame>(*item));
   }
 }

@@ -51,6 +51,10 @@ class VisualOdometry {
   void addImu(const ImuSample& sample);
   // A deskewed sweep from the LIS: its points in the lidar frame at its start t, and the lidar's pose there.
   void addSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points_lidar);
+  // The LIS's world moved (a loop correction, T_new_old): the buffered sweeps follow, so that the lidar depth of
+  // the next frames pairs the corrected LIS poses with points in the same frame. The window's own states stay in
+  // the frame it started in (the VIS is an odometry).
+  void onWorldCorrected(const Eigen::Isometry3d& T_new_old) { depth_.reanchor(T_new_old); }
   // One camera frame. Throws std::invalid_argument on an image of the wrong size or type (the caller warns and
   // skips it).
   VisFrame addFrame(const CameraFrame& frame, const PoseAt& lis_pose, const Seeder& seed);

@@ -206,4 +206,9 @@ DepthAssociationResult DepthAssociator::associate(Time t, const Eigen::Isometry3
   return result;
 }
 
+void DepthAssociator::reanchor(const Eigen::Isometry3d& T_new_old) {
+  for (Sweep& sweep : sweeps_)
+    for (Eigen::Vector3d& p : sweep.points_world) p = T_new_old * p;
+}
+
 }  // namespace drover::visual

@@ -64,6 +64,9 @@ class DepthAssociator {
   // (sweeps newer than t are not used, older than t - window are ignored).
   DepthAssociationResult associate(Time t, const Eigen::Isometry3d& T_world_cam,
                                    const std::vector<Eigen::Vector2d>& normalized) const;
+  // The world frame moved (a loop correction of the LIS): the stored sweeps' points become T_new_old * p, so that
+  // they agree with the camera poses the corrected LIS gives from now on.
+  void reanchor(const Eigen::Isometry3d& T_new_old);
   std::size_t sweepCount() const { return sweeps_.size(); }
   const DepthAssociationConfig& config() const { return config_; }
 

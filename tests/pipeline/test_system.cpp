@@ -203,13 +203,14 @@ TEST(System, StateAccessorsRefuseBeforeShutdownAndPushesAfterItAreIgnored) {
   EXPECT_EQ(system.lis().stats().scans_in, 0u);
 }
 
-// The overlap course (88 s, a loop driven and partly driven again): the loop thread, searching every keyframe in
+// The overlap course's first 70 s (the loop driven once and its start again): the loop thread, searching every keyframe in
 // order but later than the replay does, accepts the same loops: the same query keyframes, each with the replay's
 // candidate or its neighbour. (The candidate can move by one keyframe: after a correction lands some sweeps later,
 // the LIS deskews the following sweeps with a slightly different IMU state, and two neighbouring keyframes of the
-// same place can swap their Scan Context order. Measured: 10 of 10 queries equal, 9 or 10 candidates equal.)
+// same place can swap their Scan Context order. Measured on the whole 88 s course: 10 of 10 queries equal, 9 or 10
+// candidates equal.)
 TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
-  const Course course = simulate("overlap", 0, 3);
+  const Course course = simulate("overlap", 70.0, 3);
   OdometryConfig config = simConfig();
   LidarOdometry replayed(config, course.calibration);
   for (const Measurement& m : course.stream) replayed.process(m);
@@ -217,7 +218,7 @@ TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   std::vector<std::pair<std::size_t, std::size_t>> expected;
   for (const LoopEvent& e : replayed.loopClosure().events())
     if (e.verification.accepted) expected.emplace_back(e.query, e.candidate);
-  ASSERT_GE(expected.size(), 3u);
+  ASSERT_GE(expected.size(), 2u);
 
   std::atomic<std::size_t> processed{0}, corrections{0};
   SystemCallbacks cb;

@@ -24,11 +24,11 @@ struct Course {
   Trajectory truth;  // T_world_imu at 200 Hz
 };
 
-// 20 s of the sharp-turns course with its 15 Hz camera: at rest 2.5 s, 11 m straight, then turning.
+// 14 s of the sharp-turns course with its 15 Hz camera: at rest 2.5 s, 11 m straight, then turning.
 const Course& course() {
   static const Course c = [] {
     sim::ScenarioOptions so;
-    so.duration_s = 20.0;
+    so.duration_s = 14.0;
     const sim::Scenario scenario = sim::makeScenario("sharp-turns", so);
     const sim::Simulator simulator(scenario, sim::SimulatorConfig::defaults(), 5);
     Course out;
@@ -113,10 +113,10 @@ TEST(SystemVis, TheVisRunsInItsOwnThreadStartsFromTheLisAndTracksTheTruth) {
   }
   std::printf("VIS in the System: %zu frames, %zu estimated, worst position error %.3f m\n", frames.size(),
               initialized, worst);
-  EXPECT_EQ(frames.size(), 300u);  // 20 s at 15 Hz: every frame taken
+  EXPECT_EQ(frames.size(), 210u);  // 14 s at 15 Hz: every frame taken
   EXPECT_TRUE(from_lis);
   EXPECT_GT(initialized, frames.size() / 2);
-  EXPECT_LT(worst, 0.3);  // [m] over ~20 m of path
+  EXPECT_LT(worst, 0.3);  // [m] over ~12 m of path
 }
 
 }  // namespace

@@ -54,6 +54,27 @@ TEST(DepthAssociation, AFrontoParallelWallGivesItsExactDistance) {
   }
 }
 
+// A loop correction moves the LIS's world by T_new_old: the stored sweep moves with it, so a camera pose given in the
+// corrected world finds the wall at its true distance again (without the reanchor: 1 m off, or nothing).
+TEST(DepthAssociation, AReanchoredSweepAgreesWithCameraPosesInTheCorrectedWorld) {
+  DepthAssociator associator(exactConfig());
+  associator.addSweep(0, planePoints({0, 0, 5}, Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), 8, 0.1));
+  Eigen::Isometry3d T_new_old = Eigen::Isometry3d::Identity();
+  T_new_old.linear() = Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  T_new_old.translation() = Eigen::Vector3d(0.5, -0.3, 1.0);
+  const auto features = randomFeatures(100, 0.3, 2);
+  const Eigen::Isometry3d T_new_cam = T_new_old;  // the same camera (identity in the old world), corrected
+  const DepthAssociationResult stale = associator.associate(0, T_new_cam, features);
+  associator.reanchor(T_new_old);
+  const DepthAssociationResult r = associator.associate(0, T_new_cam, features);
+  EXPECT_EQ(r.associated, 100);
+  for (const FeatureDepth& f : r.features) EXPECT_NEAR(f.depth, 5.0, 1e-5);
+  int stale_right = 0;
+  for (const FeatureDepth& f : stale.features)
+    stale_right += f.status == DepthStatus::kOk && std::abs(f.depth - 5.0) < 0.05;
+  EXPECT_EQ(stale_right, 0);
+}
+
 TEST(DepthAssociation, ATiltedWallSeenFromAMovedCameraGivesTheRayPlaneIntersection) {
   DepthAssociator associator(exactConfig());
   // Wall through (2, 1, 9) with normal n, in the world; camera rotated and moved.
