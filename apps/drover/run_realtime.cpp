@@ -87,6 +87,8 @@ struct Latencies {
   std::map<Time, Clock::time_point> sweep_arrival;  // by the sweep's stamp on the IMU clock (ScanOutcome::t)
   std::vector<double> sweep_ms, imu_ms;
   double first_sweep_ms = -1;
+  std::optional<Clock::time_point> first_pose;  // when the first sweep's pose was published
+  std::size_t startup_sweeps = 0;               // sweeps after the first that arrived before it
   Clock::time_point imu_arrival;  // of the sample being pushed (the IMU-rate callback runs inside pushImu)
 };
 
@@ -111,10 +113,18 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
       std::lock_guard<std::mutex> lock(lat.mutex);
       const auto it = lat.sweep_arrival.find(s.t);
       if (it != lat.sweep_arrival.end()) {
-        // The first pose waits for the IMU's initialisation window (~1 s of data after the first sweep): reported
-        // on its own, not as a latency of the running system.
-        if (lat.first_sweep_ms < 0) lat.first_sweep_ms = msBetween(it->second, now);
-        else lat.sweep_ms.push_back(msBetween(it->second, now));
+        // Start-up: the first pose waits for the IMU's initialisation window (~1 s of data after the first sweep),
+        // and so does every sweep that arrived before it. Reported on their own, not as latencies of the running
+        // system.
+        const double ms = msBetween(it->second, now);
+        if (!lat.first_pose) {
+          lat.first_pose = now;
+          lat.first_sweep_ms = ms;
+        } else if (it->second < *lat.first_pose) {
+          ++lat.startup_sweeps;
+        } else {
+          lat.sweep_ms.push_back(ms);
+        }
         lat.sweep_arrival.erase(lat.sweep_arrival.begin(), std::next(it));
       }
     }
@@ -202,6 +212,7 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
   if (o.vis != nullptr) o.vis->attach(system.vis(), s.frames_pushed, s.frames_bad);
   run.realtime = Json{{"latency_ms", {{"sweep", percentiles(lat.sweep_ms)}, {"imu_rate", percentiles(lat.imu_ms)}}},
                       {"first_sweep_ms", lat.first_sweep_ms},
+                      {"startup_sweeps", lat.startup_sweeps},
                       {"sweeps_dropped", s.sweeps_dropped},
                       {"frames_dropped", s.frames_dropped},
                       {"sweeps_pushed", s.sweeps_pushed},
