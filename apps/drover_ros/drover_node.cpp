@@ -159,25 +159,22 @@ void DroverNode::onImu(const sensor_msgs::Imu::ConstPtr& message) {
   }
 }
 
-void DroverNode::onImage(const sensor_msgs::Image::ConstPtr& message) {
+// Image and CompressedImage alike: decoded (a bad one is dropped with a warning naming the message), then pushed.
+template <class Message>
+void DroverNode::onAnyImage(const Message& message) {
+  const std::string where = record(session_->platform().image_topic, message.header.stamp);
   try {
-    CameraFrame f = toCameraFrame(*message);
-    f.source = record(session_->platform().image_topic, message->header.stamp);
+    CameraFrame f = toCameraFrame(message);
+    f.source = where;
     session_->pushFrame(std::move(f));
   } catch (const std::exception& e) {
-    session_->dropped(record(session_->platform().image_topic, message->header.stamp) + ": dropped: " + e.what());
+    session_->dropped(where + ": dropped: " + e.what());
   }
 }
 
-void DroverNode::onCompressedImage(const sensor_msgs::CompressedImage::ConstPtr& message) {
-  try {
-    CameraFrame f = toCameraFrame(*message);
-    f.source = record(session_->platform().image_topic, message->header.stamp);
-    session_->pushFrame(std::move(f));
-  } catch (const std::exception& e) {
-    session_->dropped(record(session_->platform().image_topic, message->header.stamp) + ": dropped: " + e.what());
-  }
-}
+void DroverNode::onImage(const sensor_msgs::Image::ConstPtr& message) { onAnyImage(*message); }
+
+void DroverNode::onCompressedImage(const sensor_msgs::CompressedImage::ConstPtr& message) { onAnyImage(*message); }
 
 void DroverNode::onImuOdometry(const live::BodyPose& pose) {
   imu_odom_pub_.publish(toOdometry(pose, params_.odom_frame, params_.base_frame));

@@ -69,6 +69,8 @@ class DroverNode {
   void onImu(const sensor_msgs::Imu::ConstPtr& message);
   void onImage(const sensor_msgs::Image::ConstPtr& message);
   void onCompressedImage(const sensor_msgs::CompressedImage::ConstPtr& message);
+  template <class Message>
+  void onAnyImage(const Message& message);
   void onImuOdometry(const live::BodyPose& pose);
   void onSweep(const live::SweepResult& sweep);
   void publishView(bool with_map);

@@ -177,17 +177,27 @@ void System::Impl::lisLoop() {
 // Re-anchors the IMU front on the newest fused state, tells the VIS's board, calls back.
 void System::Impl::publish(std::vector<ScanOutcome>&& outcomes) {
   if (outcomes.empty()) return;
-  if (const std::optional<imu::FusedState> f = lis.fusedImuState()) {
+  std::optional<imu::FusedState> fused;
+  std::size_t processed = 0;
+  bool imu_initialized = false;
+  {
+    // LidarOdometry::stats() refreshes its IMU counters: not while inspect() reads the LIS from another thread.
+    std::lock_guard<std::mutex> lock(lis_state_mutex);
+    fused = lis.fusedImuState();
+    processed = lis.stats().scans_processed;
+    imu_initialized = lis.stats().imu_initialized;
+  }
+  if (fused) {
     std::lock_guard<std::mutex> lock(imu_mutex);
-    propagator.reset(f->state, f->bias);
+    propagator.reset(fused->state, fused->bias);
     anchored = true;
   }
   {
     std::lock_guard<std::mutex> lock(board_mutex);
     for (const ScanOutcome& o : outcomes)
       if (o.has_imu_state) lis_bias = imu::ImuBias{o.gyro_bias, o.acc_bias};
-    lis_sweeps = lis.stats().scans_processed;
-    lis_imu_initialized = lis.stats().imu_initialized;
+    lis_sweeps = processed;
+    lis_imu_initialized = imu_initialized;
   }
   if (cb.sweep)
     for (const ScanOutcome& o : outcomes) cb.sweep(o);
