@@ -183,13 +183,13 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   const LiveRun live{run.system->loopClosure(), run.realtime};
   writeRunFolder(context, lis, run.record, vis.get(), &live);
   folder.publish();
-  const auto& l = run.realtime["latency_ms"];
+  const auto ms = [&run](const char* output, const char* stat) {  // null (no output at all) prints as 0
+    const auto& v = run.realtime["latency_ms"][output][stat];
+    return v.is_null() ? 0.0 : v.get<double>();
+  };
   spdlog::info("realtime: latency sweep end -> pose p50 {:.1f} / p95 {:.1f} / max {:.1f} ms; IMU sample -> pose p95 "
                "{:.3f} ms; {} of {} sweeps dropped",
-               l["sweep"]["p50"].is_null() ? 0.0 : l["sweep"]["p50"].get<double>(),
-               l["sweep"]["p95"].is_null() ? 0.0 : l["sweep"]["p95"].get<double>(),
-               l["sweep"]["max"].is_null() ? 0.0 : l["sweep"]["max"].get<double>(),
-               l["imu_rate"]["p95"].is_null() ? 0.0 : l["imu_rate"]["p95"].get<double>(),
+               ms("sweep", "p50"), ms("sweep", "p95"), ms("sweep", "max"), ms("imu_rate", "p95"),
                run.realtime["sweeps_dropped"].get<std::size_t>(), run.realtime["sweeps_pushed"].get<std::size_t>());
   if (stop.requested()) throw ExitCode{128 + stop.signal()};
 }
