@@ -87,7 +87,7 @@ void keep(std::vector<pipeline::ScanOutcome>&& outcomes, RunRecord& record) {
   for (pipeline::ScanOutcome& s : outcomes) {
     if (!s.warning.empty()) spdlog::warn("sweep at {:.3f} s: {}", toSeconds(s.t), s.warning);
     if (!s.note.empty()) spdlog::info("sweep at {:.3f} s: {}", toSeconds(s.t), s.note);
-    record.scans.push_back(std::move(s));
+    record.add(s);
   }
 }
 
@@ -172,14 +172,17 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   }
   spdlog::info("drover run --realtime: {} ({}) at sensor rate -> {}", reader.describe(), o.format, o.out);
   StopOnSignal stop;
-  RealtimeRun run = runRealtime(reader, system_config, options, stop);
-  if (vis && vis->framesIn() == 0) vis.reset();  // no camera frames came: no VIS files
-  const pipeline::LidarOdometry& lis = run.system->lis();
-  for (const std::string& n : lis.stats().notices) spdlog::warn("{}", n);
-  checkSomethingWasDone(lis.stats(), o, nullptr);
+  // Staged from the start: the per-sweep lines and the IMU-rate odometry are streamed into it (a failed run leaves
+  // nothing behind, as StagedFolder removes OUT.partial unless published).
   io::StagedFolder folder(o.out, runFolderRules());
   RunContext context{o.dataset, o.format, o.config, o.out, reader.calibration(), reader.groundTruth(),
                      folder.dir().string()};
+  RealtimeRun run;
+  streamRunFiles(context, run.record, config.use_imu);
+  runRealtime(reader, system_config, options, stop, run);
+  if (vis && vis->framesIn() == 0) vis.reset();  // no camera frames came: no VIS files
+  const pipeline::LidarOdometry& lis = run.system->lis();
+  checkSomethingWasDone(lis.stats(), o, nullptr);
   const LiveRun live{run.system->loopClosure(), run.realtime};
   writeRunFolder(context, lis, run.record, vis.get(), &live);
   folder.publish();
@@ -211,12 +214,22 @@ void runOdometry(const RunOptions& o) {
   const io::GroundTruth& gt = reader->groundTruth();
   pipeline::LidarOdometry odometry(config, reader->calibration());
   spdlog::info("drover run: {} ({}) -> {}", reader->describe(), o.format, o.out);
+  // Written as OUT.partial from the start (the per-sweep lines and the IMU-rate odometry are streamed into it) and
+  // renamed at the end: a run that fails on its data leaves no folder behind, one killed while writing leaves an
+  // earlier run in OUT whole.
+  io::StagedFolder folder(o.out, runFolderRules());
+  RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string()};
 
   const double gt_span = gt.poses.size() > 1 ? toSeconds(gt.poses.back().t - gt.poses.front().t) : 0.0;
   const double total = o.duration > 0 ? (gt_span > 0 ? std::min(o.duration, gt_span - o.start) : o.duration)
                                       : std::max(0.0, gt_span - o.start);
   RunProgress progress(total);
   RunRecord record;
+  if (!no_lidar) {
+    streamRunFiles(context, record, config.use_imu);
+    if (record.imu_rate)
+      odometry.setImuRateListener([&record](const StampedPose& p) { record.imu_rate->add(p.t, p.T_world_body); });
+  }
   std::optional<Time> t_first;
   const auto showReaderDrops = [&] {
     const io::ReaderDrops& drops = reader->drops();
@@ -268,7 +281,7 @@ void runOdometry(const RunOptions& o) {
       for (const pipeline::ScanOutcome& s : outcomes) vis->onLisState(s);
     keep(std::move(outcomes), record);
     showNotices(odometry, o, record);
-    progress.update(record.scans.size(), since - o.start);
+    progress.update(record.sweeps, since - o.start);
   }
   showReaderDrops();
   if (o.max_frames > 0 && o.format == "kitti" && scans_read >= o.max_frames) record.end = "--max-frames reached";
@@ -280,16 +293,12 @@ void runOdometry(const RunOptions& o) {
   ran.no_lidar = no_lidar;
   checkSomethingWasDone(odometry.stats(), ran, vis.get());
   record.wall_s = progress.wallSeconds();
-  record.data_s = record.scans.size() > 1 ? toSeconds(record.scans.back().t - record.scans.front().t) : 0.0;
-  // Only now, and as OUT.partial: a run that fails on its data leaves no folder behind, one killed while writing
-  // leaves an earlier run in OUT whole.
-  io::StagedFolder folder(o.out, runFolderRules());
-  RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string()};
+  record.data_s = record.sweeps > 1 ? toSeconds(record.last_t - record.first_t) : 0.0;
   if (ran.no_lidar) writeVisRunFolder(context, *vis, record);
   else writeRunFolder(context, odometry, record, vis.get());
   folder.publish();
   if (!interrupted_by) return;
-  spdlog::warn("{}: wrote the {} sweeps processed before it to {}", record.end, record.scans.size(), o.out);
+  spdlog::warn("{}: wrote the {} sweeps processed before it to {}", record.end, record.sweeps, o.out);
   throw ExitCode{128 + interrupted_by};  // as a shell reports a command a signal ended
 }
 

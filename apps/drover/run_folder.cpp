@@ -12,7 +12,8 @@ namespace fs = std::filesystem;
 // tools/course_report.py adds to it (scripts/run.sh), which describes the run it replaces.
 constexpr const char* kRunFiles[] = {"trajectory.tum",  "trajectory_kitti.txt", "keyframes.tum",
                                      "trajectory_imu_rate.tum", "trajectory_vis.tum", "map.pcd",
-                                     "map.ply", "report.json", "ape.json", "ape.png", "course_report.json"};
+                                     "map.ply", "report.json", "sweeps.jsonl", "ape.json", "ape.png",
+                                     "course_report.json"};
 
 bool isRunFile(const std::string& name) {
   for (const char* f : kRunFiles)
@@ -20,11 +21,13 @@ bool isRunFile(const std::string& name) {
   return io::isStagingLeftover(name);
 }
 
-// A report.json that drover run wrote: a JSON object with its counts and per-sweep records.
+// A report.json that drover run wrote: a JSON object with its counts and its sweeps' (or the VIS's) summary; "scans"
+// is how earlier versions listed the sweeps.
 bool isRunReport(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   const nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  return j.is_object() && j.contains("counts") && (j.contains("scans") || j.contains("vis"));
+  return j.is_object() && j.contains("counts") &&
+         (j.contains("sweeps_logged") || j.contains("scans") || j.contains("vis"));
 }
 
 std::atomic<int> g_signal{0};

@@ -68,33 +68,11 @@ Json writeKittiTrajectory(const RunContext& c, const Trajectory& lidar, const Ru
   return {{"lines", filled.size()}, {"filled", fills}};
 }
 
-struct StageSummary {
-  double mean = 0, p95 = 0, max = 0;
-};
-
-StageSummary summarize(std::vector<double> v) {
-  StageSummary s;
-  if (v.empty()) return s;
-  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-  std::sort(v.begin(), v.end());
-  s.p95 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.95 * static_cast<double>(v.size())))];
-  s.max = v.back();
-  return s;
-}
-
 Json timingsJson(const RunRecord& r) {
   Json j;
-  const std::pair<const char*, double pipeline::StageTimes::*> stages[] = {
-      {"preprocess", &pipeline::StageTimes::preprocess}, {"deskew", &pipeline::StageTimes::deskew},
-      {"features", &pipeline::StageTimes::features},     {"map", &pipeline::StageTimes::map},
-      {"match", &pipeline::StageTimes::match},           {"smoother", &pipeline::StageTimes::smoother},
-      {"loop", &pipeline::StageTimes::loop},
-      {"total", &pipeline::StageTimes::total}};
-  for (const auto& [name, member] : stages) {
-    std::vector<double> v;
-    for (const auto& s : r.scans) v.push_back(s.ms.*member);
-    const StageSummary s = summarize(std::move(v));
-    j[name] = {{"mean_ms", s.mean}, {"p95_ms", s.p95}, {"max_ms", s.max}};
+  for (std::size_t i = 0; i < r.stage_ms.size(); ++i) {
+    const BoundedQuantiles& q = r.stage_ms[i];
+    j[RunRecord::stageNames()[i]] = {{"mean_ms", q.mean()}, {"p95_ms", q.quantile(0.95)}, {"max_ms", q.max()}};
   }
   return j;
 }
@@ -132,35 +110,6 @@ Json statsJson(const pipeline::OdometryStats& s, const RunRecord& r) {
   return j;
 }
 
-Json vectorJson(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
-// One compact record per sweep, for diagnosing a run; with the IMU also the smoother's velocity and biases.
-Json scansJson(const RunRecord& r) {
-  Json a = Json::array();
-  for (const pipeline::ScanOutcome& s : r.scans) {
-    a.push_back({{"t", toSeconds(s.t)},
-                 {"status", s.match_status},
-                 {"iterations", s.iterations},
-                 {"fitness_m", s.fitness},
-                 {"edge_inliers", s.edge_inliers},
-                 {"plane_inliers", s.plane_inliers},
-                 {"points", s.points},
-                 {"edges", s.edges},
-                 {"planes", s.planes},
-                 {"keyframe", s.keyframe},
-                 {"degenerate", s.degenerate_count},
-                 {"imu", s.imu_used},
-                 {"reset", s.reset},
-                 {"total_ms", s.ms.total}});
-    if (s.has_imu_state) {
-      a.back()["v_world"] = vectorJson(s.v_world);           // [m/s]
-      a.back()["gyro_bias"] = vectorJson(s.gyro_bias);       // [rad/s], IMU frame
-      a.back()["acc_bias"] = vectorJson(s.acc_bias);         // [m/s^2], IMU frame
-    }
-  }
-  return a;
-}
-
 // Translation APE after SE(3) alignment, associated within 10 ms (evo's default).
 eval::ApeOptions se3ApeOptions() {
   eval::ApeOptions options;
@@ -194,14 +143,20 @@ Json evaluate(const RunContext& c, const Trajectory& est) {
   return j;
 }
 
-// The IMU-rate odometry's count, rate [Hz] and, with ground truth, its own SE(3)-aligned translation APE [m].
-Json imuRateJson(const RunContext& c, const Trajectory& est) {
-  Json j = {{"poses", est.size()}};
-  if (est.size() < 3) return j;
-  j["rate_hz"] = static_cast<double>(est.size() - 1) / toSeconds(est.back().t - est.front().t);
+// The IMU-rate odometry (streamed during the run) finished into the folder: its count, rate [Hz] and, with ground
+// truth, its own SE(3)-aligned translation APE [m] (the file is read back for it).
+Json finishImuRate(const RunContext& c, RunRecord& r) {
+  if (!r.imu_rate) return nullptr;
+  const std::string path = inRun(c, "trajectory_imu_rate.tum");
+  const ImuRateFile::Summary s = r.imu_rate->copyTo(path);
+  r.imu_rate.reset();  // drover run's stream is closed here
+  Json j = {{"poses", s.poses}};
+  if (s.poses == 0) fs::remove(path);
+  if (s.poses < 3) return j;
+  j["rate_hz"] = static_cast<double>(s.poses - 1) / toSeconds(s.last - s.first);
   if (c.ground_truth.poses.empty()) return j;
   try {
-    j["ape"] = statisticsJson(eval::computeApe(c.ground_truth.poses, est, se3ApeOptions()).stats);
+    j["ape"] = statisticsJson(eval::computeApe(c.ground_truth.poses, io::readTum(path), se3ApeOptions()).stats);
   } catch (const std::invalid_argument& e) {
     j["ape"] = {{"error", e.what()}};
   }
@@ -260,16 +215,23 @@ void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& 
                r.wall_s > 0 ? data_s / r.wall_s : 0.0, c.out);
 }
 
-void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, const RunRecord& r,
-                    const RunVis* vis, const LiveRun* live) {
+void streamRunFiles(const RunContext& c, RunRecord& r, bool imu) {
+  r.log.streamTo(inRun(c, "sweeps.jsonl"));
+  if (!imu) return;
+  const bool imu_body = c.ground_truth.body_frame == "imu";
+  r.imu_rate = std::make_shared<ImuRateFile>(inRun(c, "trajectory_imu_rate.tum"),
+                                             imu_body ? Eigen::Isometry3d::Identity() : c.calibration.T_imu_lidar);
+}
+
+void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, RunRecord& r, const RunVis* vis,
+                    const LiveRun* live) {
   const Trajectory est = inBodyFrame(odometry.trajectory(), c);
   if (!est.empty()) {
     io::writeTum(inRun(c, "trajectory.tum"), est);
     io::writeTum(inRun(c, "keyframes.tum"), inBodyFrame(odometry.keyframeTrajectory(), c));
   }
   const Json kitti = writeKittiTrajectory(c, odometry.trajectory(), r);
-  const Trajectory imu_rate = imuRateInBodyFrame(odometry.imuRateTrajectory(), c);
-  if (!imu_rate.empty()) io::writeTum(inRun(c, "trajectory_imu_rate.tum"), imu_rate);
+  r.log.finish(inRun(c, "sweeps.jsonl"));
   const lidar::PointCloud map = odometry.mapCloud(kMapLeaf);
   io::writePcdBinary(inRun(c, "map.pcd"), map);
   io::writePlyBinary(inRun(c, "map.ply"), map);
@@ -293,11 +255,11 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   const bool live_loops = live != nullptr && live->loops != nullptr;
   report["loops"] = loopsJson(c, odometry, live_loops ? *live->loops : odometry.loopClosure());
   if (live != nullptr && !live->realtime.is_null()) report["realtime"] = live->realtime;
-  if (odometry.config().use_imu) report["imu_rate"] = imuRateJson(c, imu_rate);
+  if (odometry.config().use_imu) report["imu_rate"] = finishImuRate(c, r);
   if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
   if (vis != nullptr) report["vis"] = writeVisTrajectory(c, *vis);
   report["mode"] = std::string(report["mode"]) + (vis != nullptr && !vis->trajectory().empty() ? "+camera" : "");
-  report["scans"] = scansJson(r);
+  report["sweeps_logged"] = r.log.lines();  // sweeps.jsonl's lines
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",
                s.scans_processed, s.keyframes, s.degenerate_scans, s.smoother_resets, r.wall_s,

@@ -6,7 +6,8 @@
 //                         between its neighbours, or extrapolated at the ends), camera-0 frame, first pose identity
 //   keyframes.tum         the keyframes' poses, same frame as trajectory.tum
 //   trajectory_imu_rate.tum  with the IMU: the IMU-rate odometry (the fused state propagated to each IMU sample as
-//                         it arrives), same frame as trajectory.tum
+//                         it arrives), same frame as trajectory.tum; streamed while the run goes (RunRecord::imu_rate)
+//   sweeps.jsonl          one JSON line per processed sweep (match, features, biases, ms); streamed likewise
 //   trajectory_vis.tum    with a camera and an IMU: the VIS estimate at every camera frame after its initialisation,
 //                         same body frame as trajectory.tum (with --no-lidar trajectory.tum is this trajectory)
 //   map.pcd, map.ply      the keyframes' clouds in the world frame (binary)
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/drover/run_record.hpp"
 #include "io/reader.hpp"
 #include "pipeline/lidar_odometry.hpp"
 
@@ -33,20 +35,6 @@ struct RunContext {
   std::string dir;  // where the files are written: OUT.partial, renamed to `out` when complete
 };
 
-struct RunRecord {
-  std::vector<pipeline::ScanOutcome> scans;
-  std::vector<Time> scan_times;  // [ns] every sweep handed to the odometry, on the IMU clock (as trajectory times)
-  double wall_s = 0;  // [s] wall time of the odometry loop (reading included)
-  double data_s = 0;  // [s] time spanned by the processed sweeps
-  std::size_t notices_shown = 0;  // OdometryStats::notices already printed
-  bool fusion_announced = false;  // the "fusing: ..." line was printed
-  std::size_t reader_notices_shown = 0;  // io::ReaderDrops::notices already printed
-  std::size_t measurements_dropped = 0;  // by the reader: a repeated or backwards stamp, or an unusable reading
-  // Why the run stopped (report.json "end"): "end of data", "--duration reached", "--max-frames reached" or
-  // "interrupted by SIGINT" / "SIGTERM".
-  std::string end = "end of data";
-};
-
 // A --realtime run (pipeline::System): its loop thread's loop closure and report.json's "realtime" section.
 struct LiveRun {
   const pipeline::LoopClosure* loops = nullptr;
@@ -56,8 +44,11 @@ struct LiveRun {
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be
 // written.
 // vis: the VIS when it ran beside the LIS (nullptr otherwise); live: set for a --realtime run.
-void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, const RunRecord& record,
+// record.log and record.imu_rate are finished into the folder (closed, or copied there when streamed elsewhere).
+void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, RunRecord& record,
                     const RunVis* vis, const LiveRun* live = nullptr);
+// Before a run: its per-sweep lines and (with the IMU) its IMU-rate odometry streamed into context.dir.
+void streamRunFiles(const RunContext& context, RunRecord& record, bool imu);
 // --no-lidar: the VIS alone (trajectory.tum, trajectory_vis.tum, report.json, ape.json/png).
 void writeVisRunFolder(const RunContext& context, const RunVis& vis, const RunRecord& record);
 

@@ -72,20 +72,11 @@ class ReadAhead {
   std::thread thread_;  // last: started once the members above exist
 };
 
-Json percentiles(std::vector<double> v) {
-  if (v.empty()) return Json{{"p50", nullptr}, {"p95", nullptr}, {"max", nullptr}, {"count", 0}};
-  std::sort(v.begin(), v.end());
-  const auto at = [&](double q) {
-    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5))];
-  };
-  return Json{{"p50", at(0.50)}, {"p95", at(0.95)}, {"max", v.back()}, {"count", v.size()}};
-}
-
 // Latencies [ms], written from the System's threads.
 struct Latencies {
   std::mutex mutex;
   std::map<Time, Clock::time_point> sweep_arrival;  // by the sweep's stamp on the IMU clock (ScanOutcome::t)
-  std::vector<double> sweep_ms, imu_ms;
+  BoundedQuantiles sweep_ms, imu_ms;
   double first_sweep_ms = -1;
   std::optional<Clock::time_point> first_pose;  // when the first sweep's pose was published
   std::size_t startup_sweeps = 0;               // sweeps after the first that arrived before it
@@ -98,14 +89,14 @@ double msBetween(Clock::time_point a, Clock::time_point b) {
 
 }  // namespace
 
-RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const RealtimeOptions& o,
-                        const StopOnSignal& stop) {
-  RealtimeRun run;
+void runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const RealtimeOptions& o,
+                 const StopOnSignal& stop, RealtimeRun& run) {
   Latencies lat;
   std::mutex record_mutex;
   pipeline::SystemCallbacks cb;
-  cb.imu_odometry = [&lat](const pipeline::ImuOdometry&) {
-    lat.imu_ms.push_back(msBetween(lat.imu_arrival, Clock::now()));  // the pushing thread: no lock needed
+  cb.imu_odometry = [&lat, &run](const pipeline::ImuOdometry& p) {
+    lat.imu_ms.add(msBetween(lat.imu_arrival, Clock::now()));  // the pushing thread: no lock needed
+    if (run.record.imu_rate) run.record.imu_rate->add(p.t, p.T_world_imu);  // what a robot would have got
   };
   cb.sweep = [&](const pipeline::ScanOutcome& s) {
     const Clock::time_point now = Clock::now();
@@ -123,7 +114,7 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
         } else if (it->second < *lat.first_pose) {
           ++lat.startup_sweeps;
         } else {
-          lat.sweep_ms.push_back(ms);
+          lat.sweep_ms.add(ms);
         }
         lat.sweep_arrival.erase(lat.sweep_arrival.begin(), std::next(it));
       }
@@ -131,7 +122,7 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
     if (!s.warning.empty()) spdlog::warn("sweep at {:.3f} s: {}", toSeconds(s.t), s.warning);
     if (!s.note.empty()) spdlog::info("sweep at {:.3f} s: {}", toSeconds(s.t), s.note);
     std::lock_guard<std::mutex> lock(record_mutex);
-    run.record.scans.push_back(s);
+    run.record.add(s);
   };
   cb.loop = [](const pipeline::LoopCorrection& c) {
     spdlog::info("loop closed: keyframe {} with keyframe {} ({:.1f} s earlier), corrected by {:.2f} m", c.event.query,
@@ -204,13 +195,10 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
   if (stop.requested()) run.record.end = "interrupted by " + signalName(stop.signal());
   system.shutdown();
   run.record.wall_s = std::chrono::duration<double>(Clock::now() - wall_start).count();
-  std::sort(run.record.scans.begin(), run.record.scans.end(),
-            [](const pipeline::ScanOutcome& a, const pipeline::ScanOutcome& b) { return a.t < b.t; });
-  const auto& scans = run.record.scans;
-  run.record.data_s = scans.size() > 1 ? toSeconds(scans.back().t - scans.front().t) : 0.0;
+  run.record.data_s = run.record.sweeps > 1 ? toSeconds(run.record.last_t - run.record.first_t) : 0.0;
   const pipeline::SystemStats s = system.stats();
   if (o.vis != nullptr) o.vis->attach(system.vis(), s.frames_pushed, s.frames_bad);
-  run.realtime = Json{{"latency_ms", {{"sweep", percentiles(lat.sweep_ms)}, {"imu_rate", percentiles(lat.imu_ms)}}},
+  run.realtime = Json{{"latency_ms", {{"sweep", lat.sweep_ms.percentiles()}, {"imu_rate", lat.imu_ms.percentiles()}}},
                       {"first_sweep_ms", lat.first_sweep_ms},
                       {"startup_sweeps", lat.startup_sweeps},
                       {"sweeps_dropped", s.sweeps_dropped},
@@ -220,7 +208,6 @@ RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config
                       {"push_late_ms_max", late_ms_max},
                       {"sweep_queue", config.live.sweep_queue},
                       {"loop_rate_hz", config.live.loop_rate_hz}};
-  return run;
 }
 
 }  // namespace drover::cli

@@ -24,13 +24,14 @@ struct RealtimeOptions {
 
 struct RealtimeRun {
   std::unique_ptr<pipeline::System> system;  // shut down: its state is ready to be written
-  RunRecord record;
+  RunRecord record;  // the caller may stream its files first (streamRunFiles)
   nlohmann::json realtime;  // report.json "realtime": latency_ms {sweep, imu_rate} {p50, p95, max}, sweeps_dropped, ...
 };
 
 // Runs the whole dataset (or the --start/--duration window) through a System made from config; stops early when
-// `stop` is signalled (record.end says so).
-RealtimeRun runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const RealtimeOptions& options,
-                        const StopOnSignal& stop);
+// `stop` is signalled (run.record.end says so). The IMU-rate odometry the System publishes goes to
+// run.record.imu_rate when it is set.
+void runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const RealtimeOptions& options,
+                 const StopOnSignal& stop, RealtimeRun& run);
 
 }  // namespace drover::cli

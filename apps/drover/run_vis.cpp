@@ -77,7 +77,7 @@ void RunVis::onLisState(const pipeline::ScanOutcome& outcome) {
 std::optional<vio::SeedState> RunVis::seedAt(Time t, const pipeline::LidarOdometry& lis) const {
   if (!lis_state_ || !lis.stats().imu_initialized || lis.stats().scans_processed < pipeline::kLisSeedMinSweeps)
     return std::nullopt;
-  return pipeline::lisSeedAt(lis.imuRateTrajectory(), t, imu::ImuBias{lis_state_->gyro_bias, lis_state_->acc_bias});
+  return pipeline::lisSeedAt(lis.recentImuRate(), t, imu::ImuBias{lis_state_->gyro_bias, lis_state_->acc_bias});
 }
 
 void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis) {
@@ -85,7 +85,7 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   vio::VisualOdometry::PoseAt pose_at;
   vio::Seeder seed;
   if (lis != nullptr) {
-    pose_at = [lis](Time t) { return pipeline::lisPoseAt(lis->imuRateTrajectory(), t); };
+    pose_at = [lis](Time t) { return pipeline::lisPoseAt(lis->recentImuRate(), t); };
     // The VIS waits for the LIS to seed it while the LIS can: it fuses the IMU, or is still starting (its first
     // sweeps). An LIS that gave the IMU up (lidar only) cannot seed: the VIS then aligns visually.
     const pipeline::OdometryStats& s = lis->stats();

@@ -9,7 +9,6 @@
 namespace drover::ros_node {
 namespace {
 
-constexpr std::size_t kRecentSweeps = 8;       // sweeps kept for `cloud` while the LIS works (its queue is ~2)
 constexpr std::uint32_t kImuQueue = 2000;      // [messages] ~10 s at 200 Hz: the IMU is never dropped by ROS
 constexpr std::uint32_t kSensorQueue = 5;      // [messages] sweeps and images (the System bounds its own queues)
 
@@ -65,11 +64,15 @@ DroverNode::DroverNode(::ros::NodeHandle nh, ::ros::NodeHandle pnh)
   live::LiveCallbacks callbacks;
   callbacks.imu_odometry = [this](const live::BodyPose& p) { onImuOdometry(p); };
   callbacks.sweep = [this](const live::SweepResult& s) { onSweep(s); };
+  callbacks.deskewed_sweep = [this](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
+    onDeskewedSweep(t, T, p);
+  };
   callbacks.loop = [](const live::LoopLink& l) {
     ROS_INFO("drover: loop closed between keyframes %zu and %zu (%.3f s and %.3f s)", l.candidate, l.query,
              toSeconds(l.t_candidate), toSeconds(l.t_query));
   };
   callbacks.warning = [](const std::string& w) { ROS_WARN_STREAM("drover: " << w); };
+  callbacks.restarted = [this](const std::string&) { clearShown(); };  // e.g. `rosbag play --loop` started over
   session_ = std::make_unique<live::LiveSession>(params_.live, callbacks);
   publishStatic();
   subscribe();
@@ -136,11 +139,6 @@ std::string DroverNode::record(const std::string& topic, const ::ros::Time& stam
 void DroverNode::onCloud(const sensor_msgs::PointCloud2::ConstPtr& message) {
   try {
     io::ros::DecodedCloud cloud = toLidarScan(*message);
-    if (cloud_pub_.getNumSubscribers() > 0) {
-      std::lock_guard<std::mutex> lock(sweeps_mutex_);
-      recent_sweeps_.push_back(cloud.scan);
-      while (recent_sweeps_.size() > kRecentSweeps) recent_sweeps_.pop_front();
-    }
     session_->pushSweep(std::move(cloud.scan));
   } catch (const std::exception& e) {  // MessageError: a layout or payload the decoder cannot read
     session_->dropped(record(session_->platform().lidar_topic, message->header.stamp) + ": dropped: " + e.what());
@@ -193,17 +191,18 @@ void DroverNode::onSweep(const live::SweepResult& sweep) {
   // Without the IMU there is no IMU-rate odometry: the sweep poses carry odom -> base_link.
   if (params_.publish_tf && session_->bodyFrame() != "imu")
     tf_.sendTransform(toTransform(sweep.pose.T_world_body, sweep.pose.t, params_.odom_frame, params_.base_frame));
-  std::optional<LidarScan> scan;
-  {
-    std::lock_guard<std::mutex> lock(sweeps_mutex_);
-    const Time offset = session_->platform().calibration.lidar_time_offset;  // sweep times are on the IMU clock
-    while (!recent_sweeps_.empty() && recent_sweeps_.front().t + offset < sweep.pose.t) recent_sweeps_.pop_front();
-    if (!recent_sweeps_.empty() && recent_sweeps_.front().t + offset == sweep.pose.t) {
-      scan = std::move(recent_sweeps_.front());
-      recent_sweeps_.pop_front();
-    }
-  }
-  if (scan) cloud_pub_.publish(toPointCloud2(*scan, sweep.T_world_lidar, sweep.pose.t, params_.odom_frame));
+}
+
+// The sweep as the LIS matched it (deskewed to its start, downsampled), in the odometry frame: only while someone
+// listens.
+void DroverNode::onDeskewedSweep(Time t, const Eigen::Isometry3d& T_world_lidar,
+                                 const std::vector<Eigen::Vector3f>& points_lidar) {
+  if (cloud_pub_.getNumSubscribers() == 0) return;
+  const Eigen::Isometry3f T = T_world_lidar.cast<float>();
+  std::vector<Eigen::Vector3f> world;
+  world.reserve(points_lidar.size());
+  for (const Eigen::Vector3f& p : points_lidar) world.push_back(T * p);
+  cloud_pub_.publish(toPointCloud2(world, {}, t, params_.odom_frame));
 }
 
 void DroverNode::publishView(bool with_map) {
@@ -239,18 +238,19 @@ bool DroverNode::onSave(std_srvs::Trigger::Request&, std_srvs::Trigger::Response
   return true;
 }
 
-bool DroverNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
-  const std::string before = session_->summary();
-  session_->reset();
-  {
-    std::lock_guard<std::mutex> lock(sweeps_mutex_);
-    recent_sweeps_.clear();
-  }
+// After a reset: the newest pose goes, and the (now empty) path is published.
+void DroverNode::clearShown() {
   {
     std::lock_guard<std::mutex> lock(latest_mutex_);
     latest_.reset();
   }
   publishView(false);
+}
+
+bool DroverNode::onReset(std_srvs::Trigger::Request&, std_srvs::Trigger::Response& response) {
+  const std::string before = session_->summary();
+  session_->reset();
+  clearShown();
   response.success = true;
   response.message = "reset: a fresh map and trajectory (before: " + before + ")";
   ROS_INFO_STREAM("drover: " << response.message);

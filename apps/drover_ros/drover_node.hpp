@@ -7,8 +7,8 @@
 //   odometry/imu    nav_msgs/Odometry at the IMU rate: the IMU's pose, propagated from the LIS's newest fused state
 //   odometry/lidar  nav_msgs/Odometry per processed sweep, the body at the sweep's start
 //   path            nav_msgs/Path of the keyframes (loop corrections included), every ~path_period s
-//   cloud           sensor_msgs/PointCloud2: each processed sweep's points in the odom frame at its start pose (not
-//                   deskewed: the LIS's deskewed sweep stays inside it)
+//   cloud           sensor_msgs/PointCloud2: each processed sweep as the LIS matched it (deskewed to its start,
+//                   downsampled), in the odom frame
 //   map             sensor_msgs/PointCloud2 (latched): the keyframes' deskewed clouds in the map frame, voxel-
 //                   downsampled (~map_leaf), every ~map_period s while someone listens
 //   loops           visualization_msgs/MarkerArray: a line per accepted loop closure
@@ -30,7 +30,6 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <atomic>
-#include <deque>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -73,9 +72,11 @@ class DroverNode {
   void onAnyImage(const Message& message);
   void onImuOdometry(const live::BodyPose& pose);
   void onSweep(const live::SweepResult& sweep);
+  void onDeskewedSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points_lidar);
   void publishView(bool with_map);
   bool onSave(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
   bool onReset(std_srvs::Trigger::Request& request, std_srvs::Trigger::Response& response);
+  void clearShown();
   void subscribe();
   void publishStatic();
   std::string record(const std::string& topic, const ::ros::Time& stamp) const;
@@ -93,9 +94,6 @@ class DroverNode {
   tf2_ros::TransformBroadcaster tf_;
   tf2_ros::StaticTransformBroadcaster static_tf_;
 
-  // Recent sweeps, kept to publish each one on `cloud` once the LIS has its pose (only while someone listens).
-  std::mutex sweeps_mutex_;
-  std::deque<LidarScan> recent_sweeps_;
   std::mutex latest_mutex_;
   std::optional<live::BodyPose> latest_;  // the newest sweep pose, appended to the keyframe path
   std::atomic<bool> finished_{false};

@@ -2,9 +2,12 @@
 #include "apps/drover_ros/live_session.hpp"
 
 #include <fmt/format.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
@@ -15,14 +18,17 @@
 #include "apps/drover/run_output.hpp"
 #include "apps/drover/run_vis.hpp"
 #include "io/config.hpp"
+#include "io/odometry/live_config_io.hpp"
 #include "io/odometry/odometry_config_io.hpp"
 #include "io/output_paths.hpp"
+#include "pipeline/stream_clock.hpp"
 #include "pipeline/system.hpp"
 #include "visual/camera_model.hpp"
 
 namespace drover::live {
 namespace {
 using Clock = std::chrono::steady_clock;
+constexpr std::size_t kSweepLines = 2000;  // sweeps.jsonl of a save: the newest sweeps' lines (~200 s at 10 Hz)
 
 // Voxel-grid downsampling to each occupied voxel's centroid (PCL VoxelGrid's rule); leaf [m].
 std::vector<Eigen::Vector3f> voxelDownsample(const std::vector<Eigen::Vector3f>& points, float leaf) {
@@ -69,10 +75,23 @@ struct LiveSession::Impl {
   std::size_t dropped = 0;
   std::optional<Clock::time_point> first_sweep;  // report.json's wall_s runs from the first sweep's arrival
 
+  // Each stream's newest stamp: a jump back restarts the System before the measurement goes in (none is lost).
+  std::unique_ptr<pipeline::StreamClock> clocks;
+  std::filesystem::path scratch;          // this session's own temporary folder (the streamed IMU-rate odometry)
+
   Impl(const LiveOptions& o, LiveCallbacks c);
+  ~Impl();
   void start();
+  template <class Push>
+  void push(pipeline::StreamClock::Stream stream, Time t, const Push& f);
   pipeline::SystemCallbacks systemCallbacks();
 };
+
+LiveSession::Impl::~Impl() {
+  if (system) system->shutdown();  // its callbacks write into the scratch folder
+  std::error_code e;
+  std::filesystem::remove_all(scratch, e);
+}
 
 LiveSession::Impl::Impl(const LiveOptions& o, LiveCallbacks c) : options(o), cb(std::move(c)) {
   if (options.config.empty()) throw std::invalid_argument("no platform config given (~config)");
@@ -83,7 +102,8 @@ LiveSession::Impl::Impl(const LiveOptions& o, LiveCallbacks c) : options(o), cb(
   config.odometry = io::loadOdometryConfig(options.config);
   if (!platform.load_imu) config.odometry.use_imu = false;  // no IMU will ever come: lidar only from the start
   if (!options.use_loop) config.odometry.loop.enabled = false;
-  config.live.sweep_queue = options.sweep_queue;
+  config.live = io::loadLiveConfig(options.config);  // the node's ~sweep_queue overrides the file's
+  config.live.sweep_queue = static_cast<int>(options.sweep_queue);
   if (std::string e = config.live.validate(); !e.empty()) throw std::invalid_argument(e);
   // The VIS runs beside the LIS as in drover run: with images, an IMU and usable intrinsics.
   const std::string no_intrinsics = visual::validateIntrinsics(platform.calibration.camera);
@@ -97,18 +117,29 @@ LiveSession::Impl::Impl(const LiveOptions& o, LiveCallbacks c) : options(o), cb(
                options.config);
   }
   body_frame = config.odometry.use_imu ? "imu" : "lidar";
+  static std::atomic<int> sessions{0};
+  scratch = std::filesystem::temp_directory_path() / fmt::format("drover-live-{}-{}", ::getpid(), sessions++);
+  std::filesystem::remove_all(scratch);
+  if (!std::filesystem::create_directories(scratch))
+    throw std::runtime_error("cannot create the session's scratch folder " + scratch.string());
   if (body_frame == "imu") T_lidar_body = platform.calibration.T_imu_lidar.inverse();
 }
 
 pipeline::SystemCallbacks LiveSession::Impl::systemCallbacks() {
   pipeline::SystemCallbacks s;
   s.imu_odometry = [this](const pipeline::ImuOdometry& o) {
+    std::shared_ptr<cli::ImuRateFile> file;
+    {
+      std::lock_guard<std::mutex> lock(record_mutex);
+      file = record.imu_rate;
+    }
+    if (file) file->add(o.t, o.T_world_imu);
     if (cb.imu_odometry) cb.imu_odometry(BodyPose{o.t, o.T_world_imu, o.v_world, true});
   };
   s.sweep = [this](const pipeline::ScanOutcome& o) {
     {
       std::lock_guard<std::mutex> lock(record_mutex);
-      record.scans.push_back(o);
+      record.add(o);
     }
     if (!cb.sweep) return;
     SweepResult r;
@@ -129,6 +160,7 @@ pipeline::SystemCallbacks LiveSession::Impl::systemCallbacks() {
     if (cb.loop) cb.loop(LoopLink{c.event.query, c.event.candidate, c.event.t_query, c.event.t_candidate});
   };
   s.warning = cb.warning;
+  s.deskewed_sweep = cb.deskewed_sweep;
   return s;
 }
 
@@ -136,10 +168,18 @@ void LiveSession::Impl::start() {
   {
     std::lock_guard<std::mutex> lock(record_mutex);
     record = cli::RunRecord{};
+    // Bounded for long sessions: the newest sweeps' lines, and the IMU-rate odometry streamed to a scratch file
+    // (a save copies it).
+    record.log.keepNewest(kSweepLines);
+    if (config.odometry.use_imu)
+      record.imu_rate = std::make_shared<cli::ImuRateFile>((scratch / "trajectory_imu_rate.tum").string(),
+                                                           Eigen::Isometry3d::Identity());  // the body is the IMU
     keyframe_clouds.clear();
     dropped = 0;
     first_sweep.reset();
   }
+  clocks = std::make_unique<pipeline::StreamClock>(fromSeconds(config.live.clock_jump_s),
+                                                   fromSeconds(config.live.sensor_gap_s));
   system = std::make_unique<pipeline::System>(config, platform.calibration, systemCallbacks(), detector);
 }
 
@@ -154,25 +194,54 @@ const io::DatasetOptions& LiveSession::platform() const { return impl_->platform
 bool LiveSession::visRuns() const { return impl_->config.vis.has_value(); }
 const std::string& LiveSession::bodyFrame() const { return impl_->body_frame; }
 
+// Pushes under the shared lock. A measurement whose stream's clock jumped back first restarts the System (a
+// System that saw the jump itself would ignore all input from then on), then goes into the new one.
+template <class Push>
+void LiveSession::Impl::push(pipeline::StreamClock::Stream stream, Time t, const Push& f) {
+  pipeline::StreamClock::Verdict v;
+  {
+    std::shared_lock<std::shared_mutex> lock(system_mutex);
+    v = clocks->check(stream, t);
+    if (v.kind != pipeline::StreamClock::Kind::kJump) {
+      f(*system);
+      return;
+    }
+  }
+  {
+    std::unique_lock<std::shared_mutex> lock(system_mutex);
+    system->shutdown();
+    start();
+  }
+  const std::string why = fmt::format("the {} clock jumped back {:.3f} s ({:.6f} s after {:.6f} s): restarted with "
+                                      "an empty map", pipeline::StreamClock::name(stream), toSeconds(v.previous - t),
+                                      toSeconds(t), toSeconds(v.previous));
+  if (cb.warning) cb.warning(why);
+  if (cb.restarted) cb.restarted(why);
+  std::shared_lock<std::shared_mutex> lock(system_mutex);
+  clocks->check(stream, t);
+  f(*system);
+}
+
 void LiveSession::pushImu(const ImuSample& sample) {
-  std::shared_lock<std::shared_mutex> lock(impl_->system_mutex);
-  impl_->system->pushImu(sample);
+  impl_->push(pipeline::StreamClock::Stream::kImu, sample.t, [&](pipeline::System& s) { s.pushImu(sample); });
 }
 
 void LiveSession::pushSweep(LidarScan scan) {
-  std::shared_lock<std::shared_mutex> lock(impl_->system_mutex);
-  {
-    std::lock_guard<std::mutex> record_lock(impl_->record_mutex);
-    // On the IMU clock, as trajectory times (drover run's scan_times).
-    impl_->record.scan_times.push_back(scan.t + impl_->platform.calibration.lidar_time_offset);
-    if (!impl_->first_sweep) impl_->first_sweep = Clock::now();
-  }
-  impl_->system->pushSweep(std::move(scan));
+  const Time t = scan.t;
+  impl_->push(pipeline::StreamClock::Stream::kLidar, t, [&](pipeline::System& s) {
+    {
+      std::lock_guard<std::mutex> record_lock(impl_->record_mutex);
+      // On the IMU clock, as trajectory times (drover run's scan_times).
+      impl_->record.scan_times.push_back(scan.t + impl_->platform.calibration.lidar_time_offset);
+      if (!impl_->first_sweep) impl_->first_sweep = Clock::now();
+    }
+    s.pushSweep(std::move(scan));
+  });
 }
 
 void LiveSession::pushFrame(CameraFrame frame) {
-  std::shared_lock<std::shared_mutex> lock(impl_->system_mutex);
-  impl_->system->pushFrame(std::move(frame));
+  const Time t = frame.t;
+  impl_->push(pipeline::StreamClock::Stream::kCamera, t, [&](pipeline::System& s) { s.pushFrame(std::move(frame)); });
 }
 
 void LiveSession::dropped(const std::string& notice) {
@@ -221,11 +290,11 @@ std::string LiveSession::save(const std::string& dir, const std::string& end) {
     r.measurements_dropped = m.dropped;
     if (m.first_sweep) wall_s = std::chrono::duration<double>(Clock::now() - *m.first_sweep).count();
   }
-  if (r.scans.empty())
+  if (r.sweeps == 0)
     throw std::invalid_argument("nothing to save yet: no sweep has produced a pose (" + summary() + ")");
   r.end = end;
   r.wall_s = wall_s;
-  r.data_s = toSeconds(r.scans.back().t - r.scans.front().t);
+  r.data_s = toSeconds(r.last_t - r.first_t);
   io::StagedFolder folder(dir, cli::runFolderRules());
   io::GroundTruth none;        // live: no ground truth; the body frame sets trajectory.tum's frame
   none.body_frame = m.body_frame;
@@ -262,7 +331,7 @@ std::string LiveSession::summary() const {
   std::size_t processed = 0, keyframes = 0;
   {
     std::lock_guard<std::mutex> record_lock(impl_->record_mutex);
-    processed = impl_->record.scans.size();
+    processed = impl_->record.sweeps;
     keyframes = impl_->keyframe_clouds.size();
   }
   return fmt::format("{} sweeps pushed, {} processed, {} dropped (LIS behind); {} keyframes; {} IMU samples; {} loop "

@@ -60,8 +60,15 @@ struct LiveView {
 struct LiveCallbacks {  // called from the System's threads (see pipeline/system.hpp); must be quick
   std::function<void(const BodyPose&)> imu_odometry;  // the IMU's pose at every IMU sample once initialised
   std::function<void(const SweepResult&)> sweep;
+  // Before that sweep's `sweep`: its deskewed, downsampled points [m] in the lidar frame at the sweep's start (t on
+  // the IMU clock [ns]) and T_world_lidar there.
+  std::function<void(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points)>
+      deskewed_sweep;
   std::function<void(const LoopLink&)> loop;
   std::function<void(const std::string&)> warning;
+  // The session restarted by itself (a sensor clock jumped back: a restarted recording, a reset clock): the map and
+  // trajectory are empty again, as after reset(). Called on the pushing thread, after the restart.
+  std::function<void(const std::string& why)> restarted;
 };
 
 class LiveSession {
@@ -77,7 +84,9 @@ class LiveSession {
   bool visRuns() const;                          // the VIS runs beside the LIS
   const std::string& bodyFrame() const;          // "imu" or "lidar"
 
-  // Thread-safe; one thread per sensor keeps each stream in order. Ignored after shutdown().
+  // Thread-safe; one thread per sensor keeps each stream in order. Ignored after shutdown(). When a stream's clock
+  // jumps back (pipeline::LiveConfig::clock_jump_s) the session first restarts as reset() does and calls
+  // LiveCallbacks::restarted; the measurement then goes into the fresh System.
   void pushImu(const ImuSample& sample);
   void pushSweep(LidarScan scan);
   void pushFrame(CameraFrame frame);

@@ -2,7 +2,9 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -137,17 +139,54 @@ Eigen::Quaterniond canonicalQuaternion(const Eigen::Matrix3d& R) {
   if (q.w() < 0) q.coeffs() = -q.coeffs();
   return q;
 }
+
+constexpr const char* kTumHeader = "# t[s] x y z qx qy qz qw (T_world_body)\n";
+
+std::string tumLine(const StampedPose& p) {
+  const Eigen::Quaterniond q = canonicalQuaternion(p.T_world_body.linear());
+  const Eigen::Vector3d& x = p.T_world_body.translation();
+  return formatSeconds(p.t) + " " + joinNumbers({x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()}, " ") + "\n";
+}
 }  // namespace
 
 void writeTum(const std::string& path, const Trajectory& trajectory) {
   validateForWrite(trajectory, path);
-  std::string out = "# t[s] x y z qx qy qz qw (T_world_body)\n";
-  for (const auto& p : trajectory) {
-    const Eigen::Quaterniond q = canonicalQuaternion(p.T_world_body.linear());
-    const Eigen::Vector3d& x = p.T_world_body.translation();
-    out += formatSeconds(p.t) + " " + joinNumbers({x.x(), x.y(), x.z(), q.x(), q.y(), q.z(), q.w()}, " ") + "\n";
-  }
+  std::string out = kTumHeader;
+  for (const auto& p : trajectory) out += tumLine(p);
   writeFileAtomically(path, out);
+}
+
+TumStream::TumStream(std::string path) : path_(std::move(path)), file_(std::fopen(path_.c_str(), "w")) {
+  if (file_ == nullptr) throw IoError(path_, "", std::string("cannot open for writing: ") + std::strerror(errno));
+  if (std::fputs(kTumHeader, file_) < 0) throw IoError(path_, "", "write failed");
+}
+
+TumStream::~TumStream() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+void TumStream::add(const StampedPose& pose) {
+  if (file_ == nullptr) throw std::logic_error("TumStream::add after close: " + path_);
+  validateForWrite({pose}, path_);
+  if (count_ > 0 && pose.t <= last_)
+    throw std::invalid_argument("cannot write " + path_ + ": pose " + std::to_string(count_) +
+                                " is not after the previous one in time");
+  if (std::fputs(tumLine(pose).c_str(), file_) < 0) throw IoError(path_, "pose " + std::to_string(count_), "write failed");
+  ++count_;
+  last_ = pose.t;
+}
+
+void TumStream::flush() {
+  if (file_ != nullptr && (std::fflush(file_) != 0 || std::ferror(file_) != 0))
+    throw IoError(path_, "", "write failed (disk full?)");
+}
+
+void TumStream::close() {
+  if (file_ == nullptr) return;
+  const bool ok = std::fflush(file_) == 0 && std::ferror(file_) == 0;
+  const bool closed = std::fclose(file_) == 0;
+  file_ = nullptr;
+  if (!ok || !closed) throw IoError(path_, "", "write failed (disk full?)");
 }
 
 void writeKitti(const std::string& path, const Trajectory& trajectory,

@@ -1,5 +1,6 @@
 #pragma once
 // Trajectory files: TUM, KITTI and EuRoC ground-truth CSV, read and written.
+#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -29,6 +30,28 @@ void writeKitti(const std::string& path, const Trajectory& trajectory,
                 const std::optional<std::string>& times_path = std::nullopt);
 void writeEurocCsv(const std::string& path, const Trajectory& trajectory);
 void writeTrajectory(const std::string& path, TrajectoryFormat format, const Trajectory& trajectory);
+
+// A TUM file written pose by pose, for trajectories too long to hold (the IMU-rate odometry of an hour-long run).
+// Not atomic itself: write it inside a staged folder (io::StagedFolder). Refuses what writeTum refuses (a
+// non-finite pose, one not after the previous); throws IoError when the file cannot be opened or written.
+class TumStream {
+ public:
+  explicit TumStream(std::string path);
+  ~TumStream();  // closes without checking: call close() to learn of a failed write
+  TumStream(const TumStream&) = delete;
+  TumStream& operator=(const TumStream&) = delete;
+  void add(const StampedPose& pose);
+  void flush();  // throws IoError when a write failed
+  void close();  // flushes; idempotent
+  std::size_t size() const { return count_; }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::FILE* file_ = nullptr;
+  std::size_t count_ = 0;
+  Time last_ = 0;
+};
 
 // Writes `content` to `path` atomically (temporary file + rename). Throws IoError on failure.
 void writeFileAtomically(const std::string& path, const std::string& content);

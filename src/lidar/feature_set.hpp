@@ -19,4 +19,9 @@ struct FeatureSet {
   PointCloud full;         // every valid deskewed point, downsampled (for the map file and ICP)
 };
 
+// [bytes] the clouds' storage (what a keyframe costs in memory).
+inline std::size_t featureBytes(const FeatureSet& f) {
+  return (f.edges.capacity() + f.planes.capacity() + f.full.capacity()) * sizeof(Eigen::Vector3f);
+}
+
 }  // namespace drover::lidar

@@ -8,6 +8,7 @@
 // empty scans, stamps going backwards or repeating, IMU gaps and spikes, a diverging smoother) is handled with a
 // counted warning, never a crash: see OdometryStats.
 #include <Eigen/Geometry>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -122,9 +123,14 @@ class LidarOdometry {
   Trajectory keyframeTrajectory() const;    // T_world_lidar of the keyframes
   // IMU-rate odometry (LIO-SAM's imuPreintegration output), T_world_imu at every accepted IMU sample after the
   // initialisation: the newest fused state propagated by the IMU as each sample arrives, i.e. what a live system
-  // would publish at that moment. Causal: loop corrections move it from the next sample on, never backwards. Empty
-  // without the IMU.
-  const Trajectory& imuRateTrajectory() const;
+  // would publish at that moment. Causal: loop corrections move it from the next sample on, never backwards. None
+  // without the IMU. Every pose goes to the listener (drover run streams them to trajectory_imu_rate.tum); the
+  // last kImuRateKept of them are kept (the VIS's pose lookups).
+  static constexpr Time kImuRateKept = 10'000'000'000;  // [ns]
+  using ImuRateListener = std::function<void(const StampedPose& T_world_imu)>;
+  void setImuRateListener(ImuRateListener listener);
+  const std::deque<StampedPose>& recentImuRate() const;
+  std::size_t keyframeBytes() const;  // [bytes] the keyframe map's feature clouds
   // The keyframes' full clouds in the world frame, voxel-downsampled with leaf [m].
   lidar::PointCloud mapCloud(float leaf) const;
   const OdometryStats& stats() const;

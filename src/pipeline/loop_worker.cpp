@@ -22,4 +22,10 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
   return c;
 }
 
+std::size_t LoopWorker::keyframeBytes() const {
+  std::size_t bytes = 0;
+  for (std::size_t i = 0; i < map_.size(); ++i) bytes += lidar::featureBytes(map_.keyframe(i).features);
+  return bytes;
+}
+
 }  // namespace drover::pipeline

@@ -23,6 +23,7 @@ class LoopWorker {
   std::optional<LoopCorrection> add(const KeyframeRecord& keyframe);
 
   std::size_t keyframes() const { return map_.size(); }
+  std::size_t keyframeBytes() const;  // [bytes] the keyframes' feature clouds it keeps
   const LoopClosure& loopClosure() const { return loops_; }
 
  private:

@@ -13,6 +13,10 @@
 //   - the VIS (vio::VisualOdometry) runs in its own thread with at most live.frame_queue frames waiting, fed the IMU,
 //     the LIS's deskewed sweeps (lidar depth) and its IMU-rate poses and state (initialisation); its detector runs
 //     asynchronously in the tracker's worker thread (KLT tracks every frame while SuperPoint works).
+// Bad input is warned about and counted, never a crash or a hang: a sweep or frame out of order is skipped by its
+// stage (the LIS's notices are passed on as warnings), a sensor that stops and restarts is reported (the IMU bridges
+// a lidar gap; an IMU gap is bridged by the lidar alone), a burst drops the oldest waiting sweeps, and a clock that
+// jumps back stops the System (see SystemCallbacks::clock_jump).
 // Outputs are callbacks, each called from the thread that produced it (a callback must be quick and thread-safe
 // with respect to the caller's own data). shutdown() stops the input, lets every stage finish what is queued, and
 // joins the threads; the destructor does it if the caller did not.
@@ -38,6 +42,11 @@ struct LiveConfig {
   int sweep_queue = 2;          // [sweeps] waiting for the LIS at most; a new one then drops the oldest
   int frame_queue = 2;          // [frames] waiting for the VIS at most; likewise
   double loop_rate_hz = 1.0;    // [Hz] how often the loop thread searches the keyframes made since (LIO-SAM: 1)
+  // [s] a stamp this far before its stream's previous stamp is a clock jump (a restarted bag, a clock reset); a
+  // smaller step back is an out-of-order message, skipped by the stage that gets it
+  double clock_jump_s = 1.0;
+  // [s] a lidar or camera silent this long is reported when it speaks again (an IMU gap the LIS reports itself)
+  double sensor_gap_s = 1.0;
   std::string validate() const;  // empty when valid
 };
 
@@ -59,9 +68,16 @@ struct SystemCallbacks {
   std::function<void(const ImuOdometry&)> imu_odometry;  // pushing thread; every accepted sample once initialised
   std::function<void(const ScanOutcome&)> sweep;         // LIS thread; every processed sweep
   std::function<void(const KeyframeRecord&)> keyframe;   // LIS thread; every keyframe (map update)
+  // LIS thread, before that sweep's `sweep` callback: its deskewed, downsampled points in the lidar frame at the
+  // sweep's start and T_world_lidar there (the ROS node's ~cloud).
+  LidarOdometry::SweepListener deskewed_sweep;
   std::function<void(const LoopCorrection&)> loop;       // loop thread; every accepted loop
   std::function<void(const vio::VisFrame&)> vis_frame;   // VIS thread; every frame the VIS took
   std::function<void(const std::string&)> warning;       // any thread: dropped input, skipped frames
+  // Pushing thread: a stream's clock jumped back (stream "imu", "lidar" or "camera"; stamps [ns]). The System then
+  // ignores all input (it cannot tell a restarted recording from a robot that moved meanwhile): the owner starts a
+  // new one (drover_ros does, as its ~reset). Called once, for the first stream that jumped.
+  std::function<void(const std::string& stream, Time previous, Time now)> clock_jump;
 };
 
 struct SystemStats {
@@ -69,6 +85,9 @@ struct SystemStats {
   std::size_t sweeps_dropped = 0, frames_dropped = 0;  // dropped from full queues (the CPU fell behind)
   std::size_t loops_applied = 0;                       // loop corrections the LIS applied
   std::size_t frames_bad = 0;                          // frames the VIS rejected (wrong size, stamp order)
+  std::size_t clock_jumps = 0;                         // 0 or 1: input is ignored after the first
+  std::size_t ignored_after_jump = 0;                  // measurements pushed after the clock jumped back
+  std::size_t sensor_restarts = 0;                     // a lidar or camera silent > live.sensor_gap_s spoke again
 };
 
 class System {
@@ -91,6 +110,12 @@ class System {
   void shutdown();
 
   SystemStats stats() const;
+  // [bytes] the keyframe clouds held by the LIS's map and by the loop thread's store (the memory that grows with the
+  // map; each keyframe is in both). Thread-safe, pauses both as inspect() does.
+  struct KeyframeMemory {
+    std::size_t lis = 0, loop = 0;
+  };
+  KeyframeMemory keyframeMemory() const;
   // Calls f with the LIS and the loop search's LoopClosure (nullptr when loop closure is off) while neither works:
   // between two measurements of the LIS and two keyframes of the loop search, which wait meanwhile (input keeps
   // queueing; a full sweep queue drops its oldest as usual, so f should be quick). For reading the state while the

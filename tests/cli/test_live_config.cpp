@@ -21,8 +21,11 @@ std::string write(const TempDir& dir, const std::string& yaml) {
 TEST(LiveConfigIo, KeysReachTheConfigAndAMissingSectionKeepsTheDefaults) {
   TempDir dir;
   const pipeline::LiveConfig c =
-      io::loadLiveConfig(write(dir, "live:\n  sweep_queue: 4\n  frame_queue: 3\n  loop_rate_hz: 2.5\n"));
+      io::loadLiveConfig(write(dir, "live:\n  sweep_queue: 4\n  frame_queue: 3\n  loop_rate_hz: 2.5\n"
+                                    "  clock_jump_s: 0.5\n  sensor_gap_s: 2\n"));
   EXPECT_EQ(c.sweep_queue, 4);
+  EXPECT_DOUBLE_EQ(c.clock_jump_s, 0.5);
+  EXPECT_DOUBLE_EQ(c.sensor_gap_s, 2.0);
   EXPECT_EQ(c.frame_queue, 3);
   EXPECT_DOUBLE_EQ(c.loop_rate_hz, 2.5);
   const pipeline::LiveConfig d = io::loadLiveConfig(write(dir, "odometry:\n  use_imu: true\n"));
@@ -37,6 +40,8 @@ TEST(LiveConfigIo, AnUnknownKeyOrABadValueNamesTheFileTheLineAndTheKey) {
   expectIoError([&] { io::loadLiveConfig(unknown); }, {unknown, "line 2", "sweep_queues"});
   const std::string junk = write(dir, "live:\n  loop_rate_hz: fast\n");
   expectIoError([&] { io::loadLiveConfig(junk); }, {junk, "loop_rate_hz"});
+  const std::string no_jump = write(dir, "live:\n  clock_jump_s: 0\n");
+  expectIoError([&] { io::loadLiveConfig(no_jump); }, {no_jump, "live.clock_jump_s"});
 }
 
 }  // namespace

@@ -139,7 +139,7 @@ TEST_F(KittiRun, MapPcdAndPlyHoldTheSameMoreThanAThousandPoints) {
   EXPECT_EQ(fs::file_size(out() / "map.ply"), header_bytes + 12 * map.size());
 }
 
-TEST_F(KittiRun, ReportHasCountsTimingsApeAndOneRecordPerScan) {
+TEST_F(KittiRun, ReportHasCountsTimingsApeAndSweepsJsonlOneLinePerScan) {
   const Json r = readJson(out() / "report.json");
   EXPECT_EQ(r["format"], "kitti");
   EXPECT_EQ(r["mode"], "lidar");
@@ -152,9 +152,10 @@ TEST_F(KittiRun, ReportHasCountsTimingsApeAndOneRecordPerScan) {
   const double rmse = r["ape"]["rmse"].get<double>();
   EXPECT_TRUE(std::isfinite(rmse) && rmse >= 0) << rmse;
   EXPECT_EQ(r["ape"]["pairs"], 10);
-  ASSERT_EQ(r["scans"].size(), 10u);
-  for (std::size_t i = 1; i < r["scans"].size(); ++i)
-    EXPECT_GT(r["scans"][i]["t"].get<double>(), r["scans"][i - 1]["t"].get<double>());
+  const Json scans = readJsonLines(out() / "sweeps.jsonl");
+  ASSERT_EQ(scans.size(), 10u);
+  EXPECT_EQ(r["sweeps_logged"], 10);
+  for (std::size_t i = 1; i < scans.size(); ++i) EXPECT_GT(scans[i]["t"].get<double>(), scans[i - 1]["t"].get<double>());
   EXPECT_TRUE(fs::exists(out() / "ape.json"));
 }
 
@@ -206,14 +207,15 @@ TEST_F(SimRun, WithTheImuTheRunIsLidarPlusImuWithOnePosePerSweepInTheImuFrame) {
   expectImuHeightAboveTheMapGround(true);
   // Every sweep after the first carries the smoother's velocity [m/s] and biases; the last one's speed is the
   // ground truth's (central difference of its 200 Hz poses) to 5 cm/s (speed: the run picks its own world frame).
-  ASSERT_GT(r["scans"].size(), 30u);
-  EXPECT_FALSE(r["scans"][0].contains("v_world"));
-  for (std::size_t i = 1; i < r["scans"].size(); ++i) {
-    ASSERT_TRUE(r["scans"][i].contains("v_world")) << i;
-    EXPECT_EQ(r["scans"][i]["gyro_bias"].size(), 3u);
-    EXPECT_EQ(r["scans"][i]["acc_bias"].size(), 3u);
+  const Json scans = readJsonLines(out(true) / "sweeps.jsonl");
+  ASSERT_GT(scans.size(), 30u);
+  EXPECT_FALSE(scans[0].contains("v_world"));
+  for (std::size_t i = 1; i < scans.size(); ++i) {
+    ASSERT_TRUE(scans[i].contains("v_world")) << i;
+    EXPECT_EQ(scans[i]["gyro_bias"].size(), 3u);
+    EXPECT_EQ(scans[i]["acc_bias"].size(), 3u);
   }
-  const Json& last = r["scans"].back();
+  const Json& last = scans.back();
   const Trajectory gt = io::readTum((data() / "groundtruth.txt").string());
   const Time t = fromSeconds(last["t"].get<double>());
   std::size_t i = 1;
@@ -246,7 +248,9 @@ TEST_F(SimRun, WithTheImuTheRunWritesTheImuRateOdometryInTheImuFrame) {
 }
 TEST_F(SimRun, WithoutTheImuTheRunHasNoVelocityOrBiasRecords) {
   ASSERT_EQ(lidar_.exit_code, 0) << lidar_.output;
-  for (const Json& scan : readJson(out(false) / "report.json")["scans"]) EXPECT_FALSE(scan.contains("v_world"));
+  const Json scans = readJsonLines(out(false) / "sweeps.jsonl");
+  EXPECT_FALSE(scans.empty());
+  for (const Json& scan : scans) EXPECT_FALSE(scan.contains("v_world"));
   EXPECT_FALSE(fs::exists(out(false) / "trajectory_imu_rate.tum"));
   EXPECT_FALSE(readJson(out(false) / "report.json").contains("imu_rate"));
 }

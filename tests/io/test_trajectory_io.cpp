@@ -58,6 +58,37 @@ TEST(TrajectoryIo, TumRoundTripIsExactToTheNanosecondAnd1e9) {
   expectSame(sampleTrajectory(), readTum(path), true);
 }
 
+TEST(TrajectoryIo, TumStreamWritesWhatWriteTumWritesPoseByPose) {
+  TempDir dir;
+  const auto streamed = (dir / "s.tum").string(), whole = (dir / "w.tum").string();
+  {
+    TumStream out(streamed);
+    for (const StampedPose& p : sampleTrajectory()) out.add(p);
+    EXPECT_EQ(out.size(), sampleTrajectory().size());
+    out.close();
+    out.close();  // idempotent
+  }
+  writeTum(whole, sampleTrajectory());
+  std::ifstream a(streamed), b(whole);
+  std::stringstream sa, sb;
+  sa << a.rdbuf();
+  sb << b.rdbuf();
+  EXPECT_EQ(sa.str(), sb.str());
+  expectSame(sampleTrajectory(), readTum(streamed), true);
+}
+
+TEST(TrajectoryIo, TumStreamRefusesAPoseNotAfterThePreviousAndAFolderItCannotWriteIn) {
+  TempDir dir;
+  TumStream out((dir / "s.tum").string());
+  out.add(sampleTrajectory()[1]);
+  EXPECT_THROW(out.add(sampleTrajectory()[0]), std::invalid_argument);
+  StampedPose bad = sampleTrajectory()[2];
+  bad.T_world_body.translation().x() = std::nan("");
+  EXPECT_THROW(out.add(bad), std::invalid_argument);
+  const std::string missing = (dir / "no_such_folder" / "s.tum").string();
+  expectIoError([&] { TumStream s(missing); }, {missing, "cannot open for writing"});
+}
+
 TEST(TrajectoryIo, EurocRoundTripIsExact) {
   TempDir dir;
   const auto path = (dir / "gt.csv").string();

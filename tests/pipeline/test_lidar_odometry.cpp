@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <vector>
@@ -148,15 +149,23 @@ TEST(LidarOdometry, EverySweepReportsTheSmoothersVelocityAndBiasesWhichMatchTheT
   EXPECT_LT((outcomes.back().gyro_bias - true_gyro_bias).norm(), 5e-4) << outcomes.back().gyro_bias.transpose();
 }
 
-TEST(LidarOdometry, ImuRateOdometryFollowsTheTruthAtEveryImuSampleAfterInitialisation) {
+TEST(LidarOdometry, ImuRateOdometryFollowsTheTruthAtEveryImuSampleAfterInitialisationAndKeepsOnlyTheLastSeconds) {
   LidarOdometry odometry(simConfig(true), course().calibration);
+  Trajectory fast;  // every pose, as the listener gets them
+  odometry.setImuRateListener([&fast](const StampedPose& p) { fast.push_back(p); });
   std::size_t imu_samples = 0;
   for (const Measurement& m : course().stream) {
     imu_samples += std::holds_alternative<ImuSample>(m);
     odometry.process(m);
   }
   odometry.finish();
-  const Trajectory& fast = odometry.imuRateTrajectory();
+  // Memory for the VIS's lookups, not for the run: the last 10 s, the newest last.
+  const std::deque<StampedPose>& kept = odometry.recentImuRate();
+  ASSERT_FALSE(kept.empty());
+  EXPECT_EQ(kept.back().t, fast.back().t);
+  EXPECT_LE(kept.back().t - kept.front().t, LidarOdometry::kImuRateKept);
+  EXPECT_GT(kept.back().t - kept.front().t, LidarOdometry::kImuRateKept - 10'000'000);
+  EXPECT_LT(kept.size(), fast.size() * 3 / 4);  // the course is 16 s
   // Every sample from the first sweep on (the IMU is initialised there; the stream's IMU starts with it).
   ASSERT_GT(fast.size(), imu_samples - 2 * 200);  // 200 Hz
   EXPECT_LE(fast.size(), imu_samples);
@@ -180,9 +189,12 @@ TEST(LidarOdometry, ImuRateOdometryFollowsTheTruthAtEveryImuSampleAfterInitialis
 
 TEST(LidarOdometry, WithoutTheImuThereIsNoImuRateOdometry) {
   LidarOdometry odometry(simConfig(false), course().calibration);
+  std::size_t published = 0;
+  odometry.setImuRateListener([&published](const StampedPose&) { ++published; });
   for (const Measurement& m : course().stream) odometry.process(m);
   odometry.finish();
-  EXPECT_TRUE(odometry.imuRateTrajectory().empty());
+  EXPECT_TRUE(odometry.recentImuRate().empty());
+  EXPECT_EQ(published, 0u);
 }
 
 TEST(LidarOdometry, LidarOnlyTracksTheSameCourse) {

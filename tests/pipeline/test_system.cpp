@@ -15,30 +15,17 @@
 
 #include "eval/ape.hpp"
 #include "pipeline/system.hpp"
-#include "sim/scenario.hpp"
-#include "sim/simulator.hpp"
+#include "support/live_course.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-struct Course {
-  std::vector<Measurement> stream;
-  Calibration calibration;
-  Trajectory truth;  // T_world_imu at 200 Hz, on the IMU's and the sweeps' stamps
-};
+using test::feedAsInRealTime;
+using test::truthAt;
+using Course = test::LiveCourse;
 
 Course simulate(const std::string& name, double duration_s, unsigned seed) {
-  sim::ScenarioOptions so;
-  so.duration_s = duration_s;
-  const sim::Scenario scenario = sim::makeScenario(name, so);
-  sim::SimulatorConfig config = sim::SimulatorConfig::defaults();
-  config.enable_camera = false;
-  const sim::Simulator simulator(scenario, config, seed);
-  Course c;
-  simulator.run([&](Measurement&& m) { c.stream.push_back(std::move(m)); });
-  c.calibration = simulator.calibration();
-  c.truth = simulator.groundTruth();
-  return c;
+  return test::simulateLiveCourse(name, duration_s, seed);
 }
 
 // 16 s of the sharp-turns course (at rest 2.5 s, 11 m straight, then turning), VLP-16 and IMU.
@@ -47,13 +34,7 @@ const Course& sharpTurns() {
   return c;
 }
 
-OdometryConfig simConfig() {
-  OdometryConfig c;
-  c.layout.min_range = c.features.min_range = 0.8;
-  c.features.surf_leaf = 0.2f;
-  c.local_map.plane_leaf = 0.2;
-  return c;
-}
+OdometryConfig simConfig() { return test::simOdometryConfig(); }
 
 SystemConfig liveConfig(int sweep_queue) {
   SystemConfig c;
@@ -62,41 +43,13 @@ SystemConfig liveConfig(int sweep_queue) {
   return c;
 }
 
-void push(System& system, const Measurement& m) {
-  if (const auto* imu = std::get_if<ImuSample>(&m)) system.pushImu(*imu);
-  else if (const auto* scan = std::get_if<LidarScan>(&m)) system.pushSweep(*scan);
-  else system.pushFrame(std::get<CameraFrame>(m));
-}
+void push(System& system, const Measurement& m) { test::pushMeasurement(system, m); }
 
 Trajectory replay(const Course& course, const OdometryConfig& config) {
   LidarOdometry odometry(config, course.calibration);
   for (const Measurement& m : course.stream) odometry.process(m);
   odometry.finish();
   return odometry.trajectory();
-}
-
-// As a sensor stream with a LIS that keeps up: before each sweep, the sweeps pushed so far have been processed
-// except the newest (which waits for the IMU to cover its end). Without this the test would push 16 s of data in
-// a few milliseconds, and the IMU-rate output, which starts at the LIS's first fused sweep, would have nothing left.
-void feedAsInRealTime(System& system, const std::vector<Measurement>& stream,
-                      const std::atomic<std::size_t>& processed) {
-  std::size_t pushed = 0;
-  for (const Measurement& m : stream) {
-    if (std::holds_alternative<LidarScan>(m)) {
-      // At most a sweep period [100 ms] of waiting: the first sweeps wait for the IMU initialisation window.
-      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
-      while (processed.load() + 1 < pushed && std::chrono::steady_clock::now() < deadline)
-        std::this_thread::sleep_for(std::chrono::microseconds(200));
-      ++pushed;
-    }
-    push(system, m);
-  }
-}
-
-const Eigen::Isometry3d* truthAt(const Trajectory& truth, Time t) {
-  const auto it =
-      std::lower_bound(truth.begin(), truth.end(), t, [](const StampedPose& p, Time x) { return p.t < x; });
-  return it != truth.end() && it->t == t ? &it->T_world_body : nullptr;
 }
 
 TEST(System, FedWithoutDropsItGivesTheReplaysTrajectoryAndFlushesEverySweepAtShutdown) {

@@ -11,40 +11,21 @@
 #include <vector>
 
 #include "pipeline/system.hpp"
-#include "sim/scenario.hpp"
-#include "sim/simulator.hpp"
+#include "support/live_course.hpp"
 #include "visual/detector_factory.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-struct Course {
-  std::vector<Measurement> stream;
-  Calibration calibration;
-  Trajectory truth;  // T_world_imu at 200 Hz
-};
-
 // 14 s of the sharp-turns course with its 15 Hz camera: at rest 2.5 s, 11 m straight, then turning.
-const Course& course() {
-  static const Course c = [] {
-    sim::ScenarioOptions so;
-    so.duration_s = 14.0;
-    const sim::Scenario scenario = sim::makeScenario("sharp-turns", so);
-    const sim::Simulator simulator(scenario, sim::SimulatorConfig::defaults(), 5);
-    Course out;
-    simulator.run([&](Measurement&& m) { out.stream.push_back(std::move(m)); });
-    out.calibration = simulator.calibration();
-    out.truth = simulator.groundTruth();
-    return out;
-  }();
+const test::LiveCourse& course() {
+  static const test::LiveCourse c = test::simulateLiveCourse("sharp-turns", 14.0, 5, true);
   return c;
 }
 
 SystemConfig config() {
   SystemConfig c;
-  c.odometry.layout.min_range = c.odometry.features.min_range = 0.8;
-  c.odometry.features.surf_leaf = 0.2f;
-  c.odometry.local_map.plane_leaf = 0.2;
+  c.odometry = test::simOdometryConfig();
   c.vis = vio::VisConfig{};
   c.live.sweep_queue = 1'000'000;
   c.live.frame_queue = 1'000'000;

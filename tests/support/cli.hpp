@@ -41,6 +41,15 @@ inline nlohmann::json readJson(const std::filesystem::path& p) {
   return nlohmann::json::parse(in);
 }
 
+// A JSON-lines file (sweeps.jsonl) as an array, one element a line.
+inline nlohmann::json readJsonLines(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  EXPECT_TRUE(in.good()) << p;
+  nlohmann::json all = nlohmann::json::array();
+  for (std::string line; std::getline(in, line);) all.push_back(nlohmann::json::parse(line));
+  return all;
+}
+
 inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 }  // namespace drover::test

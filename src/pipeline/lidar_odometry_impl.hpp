@@ -1,0 +1,82 @@
+#pragma once
+// LidarOdometry's internals (src/pipeline/lidar_odometry.cpp: the interface and loop corrections;
+// lidar_odometry_sweep.cpp: the per-sweep chain). Only those two files include it.
+#include <deque>
+#include <optional>
+
+#include "lidar/deskew.hpp"
+#include "lidar/voxel_filter.hpp"
+#include "pipeline/imu_fusion.hpp"
+#include "pipeline/imu_stream_notices.hpp"
+#include "pipeline/lidar_odometry.hpp"
+
+namespace drover::pipeline {
+
+struct LidarOdometry::Impl {
+  OdometryConfig config;
+  Calibration calibration;
+  lidar::Deskewer deskewer;
+  lidar::FeatureExtractor extractor;
+  lidar::LocalMap map;
+  lidar::ScanMatcher matcher;
+  lidar::KeyframePolicy policy;
+  ImuFusion fusion;
+  ImuStreamNotices imu_notices;
+  std::optional<Time> last_imu;   // [ns] stamp of the newest accepted IMU sample
+  std::deque<LidarScan> pending;  // sweeps waiting for the IMU to cover their end (time order)
+  Trajectory trajectory;          // T_world_lidar per processed sweep
+  std::deque<StampedPose> imu_rate;  // T_world_imu per IMU sample after initialisation, the last kImuRateKept
+  ImuRateListener imu_rate_listener;  // every one of them (setImuRateListener)
+  Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
+  OdometryStats stats;
+  LoopClosure loops;
+  // Per trajectory entry: the keyframe it followed and its pose relative to it, so a loop correction of the
+  // keyframes carries every sweep with it.
+  struct Anchor {
+    std::size_t keyframe = 0;
+    Eigen::Isometry3d T_kf_sweep = Eigen::Isometry3d::Identity();
+  };
+  std::vector<Anchor> anchors;
+  geometry::Matrix6d degenerate_since_kf = geometry::Matrix6d::Zero();  // sum of d d^T since the last keyframe
+  int degenerate_run = 0;               // consecutive degenerate sweeps
+  std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
+  SweepListener sweep_listener;         // the VIS's lidar depth (setSweepListener)
+  KeyframeListener keyframe_listener;   // live: loop closure elsewhere, map updates (setKeyframeListener)
+  bool external_loops = false;
+
+  Impl(const OdometryConfig& c, const Calibration& calib)
+      : config(c),
+        calibration(calib),
+        deskewer(lidar::DeskewerConfig{}),
+        extractor(c.features),
+        map(c.local_map),
+        matcher(c.matcher),
+        policy(c.keyframes),
+        fusion(c, calib.T_imu_lidar),
+        loops(c.loop) {}
+
+  std::vector<ScanOutcome> onScan(LidarScan scan);
+  std::vector<ScanOutcome> drain(bool force);
+  std::optional<ScanOutcome> processScan(LidarScan& scan);
+  bool preprocess(LidarScan& scan, ScanOutcome& out);
+  Eigen::Isometry3d guess(Time t, bool& from_imu) const;
+  lidar::FeatureSet deskewAndExtract(const LidarScan& scan, const std::optional<lidar::SweepMotion>& motion,
+                                     ScanOutcome& out) const;
+  void match(const lidar::FeatureSet& features, const Eigen::Isometry3d& guess, ScanOutcome& out);
+  void countMatch(ScanOutcome& out);
+  void onImu(const ImuSample& sample) {
+    const imu::SampleStatus status = fusion.addImu(sample);
+    if (std::optional<std::string> line = imu_notices.onSample(sample, status, last_imu)) notice(std::move(*line));
+    if (status == imu::SampleStatus::kAccepted || status == imu::SampleStatus::kAcceptedAfterGap) last_imu = sample.t;
+  }
+  void notice(std::string line) {
+    if (stats.notices.size() < OdometryStats::kMaxNotices) stats.notices.push_back(std::move(line));
+  }
+  void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
+  void accumulateDegeneracy(const ScanOutcome& out);
+  void applyLoopCorrection(ScanOutcome& out);
+  Eigen::Isometry3d correctKeyframes(const std::vector<Eigen::Isometry3d>& poses);
+  void record(const ScanOutcome& out);
+};
+
+}  // namespace drover::pipeline
