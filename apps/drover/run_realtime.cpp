@@ -1,5 +1,6 @@
 #include "apps/drover/run_realtime.hpp"
 
+#include <pthread.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -30,7 +31,11 @@ Time arrivalOf(const Measurement& m) {
 // The reader in its own thread, a bounded number of measurements ahead of the pushes.
 class ReadAhead {
  public:
-  ReadAhead(io::Reader& reader, const StopOnSignal& stop) : thread_([this, &reader, &stop] { run(reader, stop); }) {}
+  ReadAhead(io::Reader& reader, const StopOnSignal& stop)
+      : thread_([this, &reader, &stop] {
+          pthread_setname_np(pthread_self(), "drover-reader");
+          run(reader, stop);
+        }) {}
   ~ReadAhead() {
     {
       std::lock_guard<std::mutex> lock(mutex_);

@@ -80,6 +80,14 @@ Eigen::Isometry3d LidarOdometry::applyLoopCorrection(const LoopCorrection& c) {
   return T_new_old;
 }
 
+bool LidarOdometry::prepareMap() {
+  Impl& m = *impl_;
+  if (!m.prebuild_center || m.map.size() <= m.map_first_keyframe) return false;
+  m.map.build(*m.prebuild_center, m.map_first_keyframe);
+  m.prebuild_center.reset();
+  return true;
+}
+
 std::optional<imu::FusedState> LidarOdometry::fusedImuState() const { return impl_->fusion.fusedState(); }
 
 lidar::PointCloud LidarOdometry::mapCloud(float leaf) const {

@@ -153,6 +153,11 @@ class LidarOdometry {
   // std::invalid_argument when the correction names more keyframes than the map has.
   // Returns T_new_old of the newest keyframe (what the IMU smoother and the VIS's lidar sweeps follow).
   Eigen::Isometry3d applyLoopCorrection(const LoopCorrection& correction);
+  // Live use (pipeline::System, while it waits for the next sweep): after a keyframe or a loop correction changed
+  // the map, builds the local map around the newest keyframe, which the next sweep then most likely reuses, so the
+  // rebuild (~20 ms on the farm course) is not in that sweep's latency. Changes no result: a sweep whose selection
+  // of keyframes differs rebuilds anyway. Returns whether it built.
+  bool prepareMap();
   // The IMU smoother's newest fused state (IMU mode, once initialised): where the IMU-rate odometry starts from.
   std::optional<imu::FusedState> fusedImuState() const;
 

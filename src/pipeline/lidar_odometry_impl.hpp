@@ -43,6 +43,8 @@ struct LidarOdometry::Impl {
   SweepListener sweep_listener;         // the VIS's lidar depth (setSweepListener)
   KeyframeListener keyframe_listener;   // live: loop closure elsewhere, map updates (setKeyframeListener)
   bool external_loops = false;
+  // Where the map changed (a keyframe added, a loop correction): prepareMap() builds the local map around it.
+  std::optional<Eigen::Vector3d> prebuild_center;
 
   Impl(const OdometryConfig& c, const Calibration& calib)
       : config(c),

@@ -215,6 +215,7 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
 
   const std::size_t index = map.addKeyframe(features, out.T_world_lidar);
   T_world_lastkf = out.T_world_lidar;
+  prebuild_center = out.T_world_lidar.translation();
   out.keyframe = true;
   ++stats.keyframes;
   const auto t0 = Clock::now();
@@ -262,6 +263,7 @@ Eigen::Isometry3d LidarOdometry::Impl::correctKeyframes(const std::vector<Eigen:
   for (std::size_t i = 0; i < trajectory.size(); ++i)
     trajectory[i].T_world_body = poses[anchors[i].keyframe] * anchors[i].T_kf_sweep;
   T_world_lastkf = poses[last];
+  prebuild_center = T_world_lastkf.translation();
   return T_new_old;
 }
 

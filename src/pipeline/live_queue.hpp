@@ -60,6 +60,10 @@ class LiveQueue {
     std::lock_guard<std::mutex> lock(mutex_);
     return items_.size();
   }
+  std::size_t droppableWaiting() const {  // sweeps (frames) waiting
+    std::lock_guard<std::mutex> lock(mutex_);
+    return droppable_;
+  }
 
  private:
   mutable std::mutex mutex_;

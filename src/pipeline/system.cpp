@@ -1,6 +1,7 @@
 #include "pipeline/system.hpp"
 
 #include <fmt/format.h>
+#include <pthread.h>
 
 #include <cmath>
 
@@ -87,9 +88,21 @@ System::System(const SystemConfig& config, const Calibration& calibration, Syste
                std::shared_ptr<visual::KeypointDetector> detector)
     : impl_(std::make_unique<Impl>(config, calibration, std::move(callbacks), std::move(detector))) {
   Impl& m = *impl_;
-  m.lis_thread = std::thread([&m] { m.lisLoop(); });
-  if (m.loops) m.loop_thread = std::thread([&m] { m.loopLoop(); });
-  if (m.vo) m.vis_thread = std::thread([&m] { m.visLoop(); });
+  // Named, so that `top -H` on the robot says which stage takes the CPU.
+  m.lis_thread = std::thread([&m] {
+    pthread_setname_np(pthread_self(), "drover-lis");
+    m.lisLoop();
+  });
+  if (m.loops)
+    m.loop_thread = std::thread([&m] {
+      pthread_setname_np(pthread_self(), "drover-loop");
+      m.loopLoop();
+    });
+  if (m.vo)
+    m.vis_thread = std::thread([&m] {
+      pthread_setname_np(pthread_self(), "drover-vis");
+      m.visLoop();
+    });
 }
 
 System::~System() { shutdown(); }

@@ -49,7 +49,13 @@ void System::Impl::lisLoop() {
       notices = takeNotices();
     }
     for (const std::string& n : notices) warn("LIS: " + n);
+    const bool done_sweep = !outcomes.empty();
     publish(std::move(outcomes));
+    // Idle until the next sweep: the local map for it is built now, not in its latency.
+    if (done_sweep && lis_queue.droppableWaiting() == 0) {
+      std::lock_guard<std::mutex> lock(lis_state_mutex);
+      lis.prepareMap();
+    }
   }
   std::vector<ScanOutcome> outcomes;
   std::vector<std::string> notices;

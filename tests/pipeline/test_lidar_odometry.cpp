@@ -187,6 +187,22 @@ TEST(LidarOdometry, ImuRateOdometryFollowsTheTruthAtEveryImuSampleAfterInitialis
   EXPECT_LT(worst, 0.15);
 }
 
+// The live system builds the next local map while it waits for the next sweep: the trajectory must not change.
+TEST(LidarOdometry, PreparingTheMapBetweenSweepsChangesNoPose) {
+  LidarOdometry plain(simConfig(true), course().calibration), prepared(simConfig(true), course().calibration);
+  std::size_t built = 0;
+  for (const Measurement& m : course().stream) {
+    plain.process(m);
+    if (!prepared.process(m).empty()) built += prepared.prepareMap() ? 1 : 0;
+  }
+  plain.finish();
+  prepared.finish();
+  EXPECT_EQ(built, prepared.stats().keyframes);  // once after each keyframe
+  ASSERT_EQ(plain.trajectory().size(), prepared.trajectory().size());
+  for (std::size_t i = 0; i < plain.trajectory().size(); ++i)
+    EXPECT_EQ(plain.trajectory()[i].T_world_body.matrix(), prepared.trajectory()[i].T_world_body.matrix()) << i;
+}
+
 TEST(LidarOdometry, WithoutTheImuThereIsNoImuRateOdometry) {
   LidarOdometry odometry(simConfig(false), course().calibration);
   std::size_t published = 0;
