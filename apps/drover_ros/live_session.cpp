@@ -71,7 +71,8 @@ struct LiveSession::Impl {
   // What the callbacks collect for the run folder and the map, since the System started.
   mutable std::mutex record_mutex;
   cli::RunRecord record;
-  std::vector<std::vector<Eigen::Vector3f>> keyframe_clouds;  // [m] lidar frame, by keyframe index
+  // By keyframe index: the LIS's own keyframe clouds (lidar frame, [m]), shared, not copied.
+  std::vector<std::shared_ptr<const lidar::FeatureSet>> keyframe_clouds;
   std::size_t dropped = 0;
   std::optional<Clock::time_point> first_sweep;  // report.json's wall_s runs from the first sweep's arrival
 
@@ -154,7 +155,7 @@ pipeline::SystemCallbacks LiveSession::Impl::systemCallbacks() {
   s.keyframe = [this](const pipeline::KeyframeRecord& k) {
     std::lock_guard<std::mutex> lock(record_mutex);
     if (keyframe_clouds.size() <= k.index) keyframe_clouds.resize(k.index + 1);
-    keyframe_clouds[k.index] = k.features.full;
+    keyframe_clouds[k.index] = k.features;
   };
   s.loop = [this](const pipeline::LoopCorrection& c) {
     if (cb.loop) cb.loop(LoopLink{c.event.query, c.event.candidate, c.event.t_query, c.event.t_candidate});
@@ -273,7 +274,8 @@ LiveView LiveSession::view(float map_leaf) const {
     std::lock_guard<std::mutex> lock(impl_->record_mutex);
     for (std::size_t i = 0; i < lidar.size() && i < impl_->keyframe_clouds.size(); ++i) {
       const Eigen::Isometry3f T = lidar[i].T_world_body.cast<float>();
-      for (const Eigen::Vector3f& p : impl_->keyframe_clouds[i]) world.push_back(T * p);
+      if (impl_->keyframe_clouds[i])
+        for (const Eigen::Vector3f& p : impl_->keyframe_clouds[i]->full) world.push_back(T * p);
     }
   }
   v.map = voxelDownsample(world, map_leaf);

@@ -96,14 +96,23 @@ LocalMap& LocalMap::operator=(LocalMap&&) noexcept = default;
 
 std::size_t LocalMap::addKeyframe(const FeatureSet& features, const Eigen::Isometry3d& T_world_lidar) {
   if (!T_world_lidar.matrix().allFinite()) throw std::invalid_argument("LocalMap::addKeyframe: non-finite pose");
+  auto stored = std::make_shared<FeatureSet>();
+  stored->t = features.t;
+  stored->edges = detail::voxelDownsample(features.edges, static_cast<float>(config_.edge_leaf));
+  stored->planes = detail::voxelDownsample(features.planes, static_cast<float>(config_.plane_leaf));
+  stored->full = detail::voxelDownsample(features.full, static_cast<float>(config_.full_leaf));
+  return addSharedKeyframe(std::move(stored), T_world_lidar);
+}
+
+std::size_t LocalMap::addSharedKeyframe(std::shared_ptr<const FeatureSet> downsampled,
+                                        const Eigen::Isometry3d& T_world_lidar) {
+  if (!downsampled) throw std::invalid_argument("LocalMap::addSharedKeyframe: no features");
+  if (!T_world_lidar.matrix().allFinite()) throw std::invalid_argument("LocalMap::addKeyframe: non-finite pose");
   Keyframe keyframe;
   keyframe.index = impl_->keyframes.size();
-  keyframe.t = features.t;
+  keyframe.t = downsampled->t;
   keyframe.T_world_lidar = T_world_lidar;
-  keyframe.features.t = features.t;
-  keyframe.features.edges = detail::voxelDownsample(features.edges, static_cast<float>(config_.edge_leaf));
-  keyframe.features.planes = detail::voxelDownsample(features.planes, static_cast<float>(config_.plane_leaf));
-  keyframe.features.full = detail::voxelDownsample(features.full, static_cast<float>(config_.full_leaf));
+  keyframe.shared = std::move(downsampled);
   impl_->keyframes.push_back(std::move(keyframe));
   return impl_->keyframes.size() - 1;
 }
@@ -173,8 +182,8 @@ LocalMapBuild LocalMap::build(const Eigen::Vector3d& center_world, std::size_t f
   for (std::size_t index : missing) slots.push_back(&m.cache[index]);
   tbb::parallel_for(std::size_t{0}, missing.size(), [&](std::size_t i) {
     const Keyframe& kf = m.keyframes[missing[i]];
-    slots[i]->edges_world = transformCloud(kf.features.edges, kf.T_world_lidar);
-    slots[i]->planes_world = transformCloud(kf.features.planes, kf.T_world_lidar);
+    slots[i]->edges_world = transformCloud(kf.features().edges, kf.T_world_lidar);
+    slots[i]->planes_world = transformCloud(kf.features().planes, kf.T_world_lidar);
   });
   result.transformed = missing.size();
 
@@ -248,7 +257,7 @@ PointCloud LocalMap::fullCloudWorld(std::span<const std::size_t> indices, float 
   PointCloud out;
   for (std::size_t index : indices) {
     const Keyframe& kf = impl_->at(index);
-    const PointCloud world = transformCloud(kf.features.full, kf.T_world_lidar);
+    const PointCloud world = transformCloud(kf.features().full, kf.T_world_lidar);
     out.insert(out.end(), world.begin(), world.end());
   }
   return leaf > 0.0f ? detail::voxelDownsample(out, leaf) : out;

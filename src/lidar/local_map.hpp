@@ -43,7 +43,10 @@ struct Keyframe {
   std::size_t index = 0;                                            // position in the map, 0..size()-1
   Time t = 0;                                                       // [ns] the FeatureSet's sweep start
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();  // maps keyframe lidar points to the world
-  FeatureSet features;                                              // lidar frame
+  // Lidar frame, downsampled with the map's leaves; immutable, so other maps (the live loop thread's) share it
+  // instead of holding a copy.
+  std::shared_ptr<const FeatureSet> shared;
+  const FeatureSet& features() const { return *shared; }
 };
 
 // What build() did.
@@ -69,6 +72,9 @@ class LocalMap {
   // should arrive in time order (the recent window is measured from the last one added). Throws
   // std::invalid_argument on a non-finite pose.
   std::size_t addKeyframe(const FeatureSet& features, const Eigen::Isometry3d& T_world_lidar);
+  // The same for features another LocalMap with the same leaves already downsampled (its Keyframe::shared): stored
+  // as they are, shared, not copied. Throws std::invalid_argument on a null pointer or a non-finite pose.
+  std::size_t addSharedKeyframe(std::shared_ptr<const FeatureSet> downsampled, const Eigen::Isometry3d& T_world_lidar);
   // Corrects a keyframe's pose (loop closure); its cached world clouds are dropped and the next build()
   // reassembles. Throws std::invalid_argument on a bad index or non-finite pose.
   void updatePose(std::size_t index, const Eigen::Isometry3d& T_world_lidar);

@@ -46,7 +46,7 @@ void LidarOdometry::setImuRateListener(ImuRateListener listener) { impl_->imu_ra
 
 std::size_t LidarOdometry::keyframeBytes() const {
   std::size_t bytes = 0;
-  for (std::size_t i = 0; i < impl_->map.size(); ++i) bytes += lidar::featureBytes(impl_->map.keyframe(i).features);
+  for (std::size_t i = 0; i < impl_->map.size(); ++i) bytes += lidar::featureBytes(impl_->map.keyframe(i).features());
   return bytes;
 }
 

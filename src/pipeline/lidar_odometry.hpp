@@ -90,7 +90,7 @@ struct OdometryStats {
 struct KeyframeRecord {
   std::size_t index = 0;                                               // in the LIS's keyframe map
   Time t = 0;                                                          // [ns]
-  lidar::FeatureSet features;                                          // lidar frame
+  std::shared_ptr<const lidar::FeatureSet> features;  // lidar frame, the LIS map's downsampled clouds (shared)
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();     // the LIS's estimate when it was made
   Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();   // relative to the previous keyframe
   geometry::Matrix6d degenerate_cov = geometry::Matrix6d::Zero();      // as LoopClosure::addKeyframe takes it

@@ -221,7 +221,7 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
   const auto t0 = Clock::now();
   if (keyframe_listener) {
     const Eigen::Isometry3d T_previous = index > 0 ? map.keyframe(index - 1).T_world_lidar : out.T_world_lidar;
-    keyframe_listener(KeyframeRecord{index, out.t, features, out.T_world_lidar,
+    keyframe_listener(KeyframeRecord{index, out.t, map.keyframe(index).shared, out.T_world_lidar,
                                      T_previous.inverse() * out.T_world_lidar, degenerate_since_kf});
   }
   const bool closed = !external_loops && loops.addKeyframe(map, index, degenerate_since_kf);

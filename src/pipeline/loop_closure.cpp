@@ -119,7 +119,7 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
 
   auto t0 = Clock::now();
   const loop::AugmentedScanContext query =
-      loop::makeAugmentedScanContext(kf.features.full, m.config.database.descriptor);
+      loop::makeAugmentedScanContext(kf.features().full, m.config.database.descriptor);
   m.stats.descriptor_ms += msSince(t0);
   bool closed = false;
   if (m.skip > 0) {
@@ -209,7 +209,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
   std::size_t candidate_in_submap = 0;
   for (std::size_t i = first; i <= c.index + n && i < index && times[i] <= newest; ++i) {
     if (i == c.index) candidate_in_submap = submap.size();
-    submap.push_back({&map.keyframe(i).features, map.keyframe(i).T_world_lidar});
+    submap.push_back({&map.keyframe(i).features(), map.keyframe(i).T_world_lidar});
   }
   LoopEvent e;
   e.query = index;
@@ -229,7 +229,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
   }
   auto t0 = Clock::now();
   e.verification =
-      verifier.verify(map.keyframe(index).features, submap, candidate_in_submap, c.T_candidate_query_guess);
+      verifier.verify(map.keyframe(index).features(), submap, candidate_in_submap, c.T_candidate_query_guess);
   stats.verify_ms += msSince(t0);
   ++stats.verified;
   if (e.verification.accepted) checkDriftBudget(map, e);

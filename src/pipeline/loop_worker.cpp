@@ -13,7 +13,7 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
     throw std::invalid_argument(fmt::format("loop worker: keyframe {} given, {} expected", kf.index, map_.size()));
   const Eigen::Isometry3d T_world_lidar =
       kf.index == 0 ? kf.T_world_lidar : map_.keyframe(kf.index - 1).T_world_lidar * kf.T_previous_this;
-  map_.addKeyframe(kf.features, T_world_lidar);
+  map_.addSharedKeyframe(kf.features, T_world_lidar);  // the LIS's own clouds, not a copy
   if (!loops_.addKeyframe(map_, kf.index, kf.degenerate_cov)) return std::nullopt;
   LoopCorrection c;
   c.poses = loops_.poses();
@@ -24,7 +24,8 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
 
 std::size_t LoopWorker::keyframeBytes() const {
   std::size_t bytes = 0;
-  for (std::size_t i = 0; i < map_.size(); ++i) bytes += lidar::featureBytes(map_.keyframe(i).features);
+  for (std::size_t i = 0; i < map_.size(); ++i)  // those the LIS no longer holds (none while it runs)
+    if (map_.keyframe(i).shared.use_count() == 1) bytes += lidar::featureBytes(map_.keyframe(i).features());
   return bytes;
 }
 

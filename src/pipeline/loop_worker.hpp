@@ -23,7 +23,8 @@ class LoopWorker {
   std::optional<LoopCorrection> add(const KeyframeRecord& keyframe);
 
   std::size_t keyframes() const { return map_.size(); }
-  std::size_t keyframeBytes() const;  // [bytes] the keyframes' feature clouds it keeps
+  // [bytes] the keyframes' feature clouds only it holds (it shares the LIS's: 0 while the LIS lives)
+  std::size_t keyframeBytes() const;
   const LoopClosure& loopClosure() const { return loops_; }
 
  private:

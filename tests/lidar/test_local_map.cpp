@@ -108,13 +108,27 @@ TEST(LocalMap, ReusesCachedKeyframesAndSkipsAnUnchangedRebuild) {
   EXPECT_EQ(grown.keyframes.size(), 3u);
 }
 
+// The live loop thread's keyframe store takes the LIS's keyframe clouds as they are: the same memory, the same map.
+TEST(LocalMap, ASharedKeyframeIsTheOtherMapsCloudsNotACopy) {
+  LocalMap lis, loop;
+  lis.addKeyframe(patch(0.0, 5000, 3), at(0.0));
+  loop.addSharedKeyframe(lis.keyframe(0).shared, at(0.0));
+  EXPECT_EQ(loop.keyframe(0).shared.get(), lis.keyframe(0).shared.get());
+  EXPECT_EQ(lis.keyframe(0).shared.use_count(), 2);
+  lis.build(Eigen::Vector3d::Zero());
+  loop.build(Eigen::Vector3d::Zero());
+  EXPECT_EQ(loop.planesWorld(), lis.planesWorld());
+  EXPECT_EQ(loop.edgesWorld(), lis.edgesWorld());
+  EXPECT_THROW(loop.addSharedKeyframe(nullptr, at(0.0)), std::invalid_argument);
+}
+
 TEST(LocalMap, VoxelDownsamplingBoundsThePointCount) {
   LocalMap map;  // planes 0.4 m, edges 0.2 m
   // Twenty keyframes of 5000 points each at the same place: the 2 m x 2 m patch holds at most 6 x 6 plane
   // voxels and the 2 m edge line at most 11 edge voxels, however many keyframes overlap.
   for (int i = 0; i < 20; ++i) map.addKeyframe(patch(0.1 * i, 5000, 10 + i), at(0.0));
-  EXPECT_LE(map.keyframe(0).features.planes.size(), 36u);
-  EXPECT_LE(map.keyframe(0).features.edges.size(), 11u);
+  EXPECT_LE(map.keyframe(0).features().planes.size(), 36u);
+  EXPECT_LE(map.keyframe(0).features().edges.size(), 11u);
   const LocalMapBuild build = map.build(Eigen::Vector3d::Zero());
   EXPECT_EQ(build.keyframes.size(), 20u);
   EXPECT_LE(build.plane_points, 36u);

@@ -192,6 +192,9 @@ TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
     EXPECT_LE(std::abs(static_cast<long>(got[i].second) - static_cast<long>(expected[i].second)), 1) << i;
   }
   EXPECT_EQ(corrections.load(), got.size());
+  const System::KeyframeMemory memory = system.keyframeMemory();
+  EXPECT_GT(memory.lis, 1'000'000u);  // [bytes] ~0.1 MB a keyframe
+  EXPECT_EQ(memory.loop, 0u) << "the loop thread shares the LIS's keyframe clouds";
   EXPECT_GE(system.stats().loops_applied, 1u);
   // The corrections reached the LIS. Its trajectory differs from the replay's where a correction landed later
   // (the sweeps matched in between, against the uncorrected map): measured 5.0 cm at worst. Against the truth both
