@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -114,6 +115,13 @@ struct PoseGraph::Impl {
   ceres::Problem problem;  // declared last: destroyed before the manifold and the loss it points to
 
   explicit Impl(const Config& c) : config(c), loop_loss(makeLoss(c)), problem(problemOptions()) {}
+
+  bool allFinite() const {
+    for (const auto& [id, n] : nodes)
+      for (double v : {n.p[0], n.p[1], n.p[2], n.q[0], n.q[1], n.q[2], n.q[3]})
+        if (!std::isfinite(v)) return false;
+    return true;
+  }
 
   NodeBlock& node(int id, const char* who) {
     const auto it = nodes.find(id);
@@ -284,6 +292,12 @@ PoseGraphResult PoseGraph::optimize() {
   result.initial_cost = summary.initial_cost;
   result.final_cost = summary.final_cost;
   result.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+  // A solve Ceres calls usable can still leave a non-finite pose (seen once, live, after ~800 loops of an hour on
+  // the farm course): every later solve then fails and a correction would carry NaN. Refused and rolled back.
+  if (result.usable && !impl_->allFinite()) {
+    result.usable = result.converged = false;
+    result.reason = "non-finite solution (" + summary.message + ")";
+  }
   if (!result.usable) {
     for (auto& [id, node] : impl_->nodes) {
       const NodeBlock& old = before.at(id);

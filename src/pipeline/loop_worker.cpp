@@ -17,6 +17,8 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
   if (!loops_.addKeyframe(map_, kf.index, kf.degenerate_cov)) return std::nullopt;
   LoopCorrection c;
   c.poses = loops_.poses();
+  for (const Eigen::Isometry3d& T : c.poses)  // never hand the LIS a pose it would refuse (the graph guards this)
+    if (!T.matrix().allFinite()) throw std::runtime_error("loop worker: the pose graph gave a non-finite pose");
   for (std::size_t i = 0; i < c.poses.size(); ++i) map_.updatePose(i, c.poses[i]);
   c.event = loops_.events().back();
   return c;

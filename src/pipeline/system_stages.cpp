@@ -107,7 +107,13 @@ void System::Impl::applyCorrection() {
     has_correction = false;
   }
   if (!c) return;
-  const Eigen::Isometry3d T_new_old = lis.applyLoopCorrection(*c);
+  Eigen::Isometry3d T_new_old;
+  try {
+    T_new_old = lis.applyLoopCorrection(*c);
+  } catch (const std::exception& e) {  // a correction the LIS refuses is dropped, never a crash of the live system
+    warn(fmt::format("live: loop correction of keyframe {} not applied: {}", c->event.query, e.what()));
+    return;
+  }
   if (vo) vis_queue.push(WorldCorrection{T_new_old}, false, 0);
   std::lock_guard<std::mutex> lock(stats_mutex);
   ++stats.loops_applied;
@@ -127,9 +133,12 @@ void System::Impl::loopLoop() {
     }
     for (const KeyframeRecord& k : batch) {
       std::optional<LoopCorrection> c;
-      {
+      try {
         std::lock_guard<std::mutex> lock(loop_state_mutex);
         c = loops->add(k);
+      } catch (const std::exception& e) {  // the search goes on with the next keyframe; the LIS never stops
+        warn(fmt::format("live: loop search at keyframe {} failed: {}", k.index, e.what()));
+        continue;
       }
       if (!c) continue;
       if (cb.loop) cb.loop(*c);
