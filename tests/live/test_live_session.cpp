@@ -70,12 +70,18 @@ live::LiveOptions optionsFor(const Course& c) {
   return o;
 }
 
+// drover run on the course (the reference the live session is held to); false, with the output, when it failed.
+::testing::AssertionResult runOffline(const Course& course, const fs::path& out) {
+  const CliResult r = runDrover("run " + course.dir.string() + " --format sim --config " + course.config.string() +
+                                " --no-camera -q --out " + out.string());
+  if (r.exit_code == 0) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << r.output;
+}
+
 TEST(LiveSession, FedInTimeOrderItPublishesAndSavesTheTrajectoryOfDroverRun) {
   const TempDir tmp;
   const Course course = makeCourse(tmp);
-  const CliResult offline = runDrover("run " + course.dir.string() + " --format sim --config " +
-                                      course.config.string() + " --no-camera -q --out " + (tmp / "offline").string());
-  ASSERT_EQ(offline.exit_code, 0) << offline.output;
+  ASSERT_TRUE(runOffline(course, tmp / "offline"));
 
   std::atomic<std::size_t> sweeps{0}, keyframes{0}, deskewed{0}, paired{0};
   std::mutex mutex;
@@ -154,9 +160,7 @@ TEST(LiveSession, ResetStartsAnEmptyMapAfterWhichSaveHasNothingToWriteUntilNewSw
 TEST(LiveSession, AClockThatJumpsBackRestartsTheSessionWhichThenMapsTheNewPassAsAFreshRun) {
   const TempDir tmp;
   const Course course = makeCourse(tmp);
-  const CliResult offline = runDrover("run " + course.dir.string() + " --format sim --config " +
-                                      course.config.string() + " --no-camera -q --out " + (tmp / "offline").string());
-  ASSERT_EQ(offline.exit_code, 0) << offline.output;
+  ASSERT_TRUE(runOffline(course, tmp / "offline"));
   std::atomic<std::size_t> restarts{0}, warned{0};
   live::LiveCallbacks cb;
   cb.restarted = [&](const std::string&) { ++restarts; };
