@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "apps/drover/run_record.hpp"
+#include "io/odometry/odometry_config_io.hpp"
 #include "pipeline/system.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
@@ -35,12 +36,8 @@ long statusKb(const std::string& field) {
   return -1;
 }
 
-pipeline::OdometryConfig farmConfig() {  // config/farm_sim.yaml's odometry section, as the tests' courses use it
-  pipeline::OdometryConfig c;
-  c.layout.min_range = c.features.min_range = 0.8;
-  c.features.surf_leaf = 0.2f;
-  c.local_map.plane_leaf = 0.2;
-  return c;
+pipeline::OdometryConfig farmConfig() {  // the platform file drover run uses for the farm course
+  return io::loadOdometryConfig(std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml");
 }
 
 struct Lap {
