@@ -8,13 +8,18 @@
 // After every lap it prints the process's resident memory (VmRSS) and peak (VmHWM), the keyframes and the bytes of
 // their feature clouds (the LIS's map and the loop thread's store), and at the end the ratio of the hour's peak to
 // the first lap's (the 10-minute course), overall and without the keyframe clouds.
-//   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp]
+// MODE replay drives the same laps through the deterministic replay (LidarOdometry with its loop closure in line,
+// as drover run): the same numbers, reproducible, plus each lap's loop-closure counts (verified, accepted, refused
+// by the drift budget, refused by the pose graph) to follow the loop closure over hours.
+//   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay]
 #include <fmt/format.h>
 
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -45,7 +50,118 @@ struct Lap {
   double data_s = 0, wall_s = 0;
   long rss_kb = 0, peak_kb = 0;
   std::size_t sweeps = 0, keyframes = 0, dropped = 0, loops = 0;
-  pipeline::System::KeyframeMemory kf;
+  std::size_t kf_lis = 0, kf_loop = 0;  // [bytes] keyframe clouds held by the LIS, and by the loop thread alone
+  std::size_t retired = 0;               // keyframes whose clouds were freed (a newer one stands for the place)
+  std::size_t cache = 0, descriptors = 0;  // [bytes] the local map's world-frame cache, the Scan Context database
+  pipeline::LoopStats loop_stats;        // cumulative
+  std::size_t graph_refusals = 0;        // verified loops the pose graph failed to solve (cumulative)
+};
+
+// Loops the pose graph refused: verified, within the drift budget, rolled back because the solve failed.
+std::size_t graphRefusals(const pipeline::LoopClosure& loops) {
+  std::size_t n = 0;
+  for (const pipeline::LoopEvent& e : loops.events())
+    if (e.verification.reason.rfind("rejected: pose graph failed", 0) == 0) ++n;
+  return n;
+}
+
+// The System (live threads) or LidarOdometry (replay, in line) fed measurement by measurement.
+class Runner {
+ public:
+  virtual ~Runner() = default;
+  virtual void push(Measurement&& m) = 0;
+  virtual void fill(Lap& row) = 0;  // counts and memory so far
+  virtual void finish() = 0;
+  cli::RunRecord record;
+};
+
+class LiveRunner : public Runner {
+ public:
+  LiveRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration) {
+    pipeline::SystemCallbacks cb;
+    cb.imu_odometry = [this](const pipeline::ImuOdometry& o) { record.imu_rate->add(o.t, o.T_world_imu); };
+    cb.sweep = [this](const pipeline::ScanOutcome& s) {
+      {
+        std::lock_guard<std::mutex> lock(record_mutex_);
+        record.add(s);
+      }
+      ++processed_;
+    };
+    pipeline::SystemConfig config;
+    config.odometry = odometry;
+    config.live.sweep_queue = 4;
+    system_ = std::make_unique<pipeline::System>(config, calibration, cb);
+  }
+  void push(Measurement&& m) override {
+    if (auto* imu = std::get_if<ImuSample>(&m)) {
+      system_->pushImu(*imu);
+    } else if (auto* scan = std::get_if<LidarScan>(&m)) {
+      // As fast as it keeps up: the next sweep goes in once the one before it is processed.
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
+      while (processed_.load() + system_->stats().sweeps_dropped + 1 < pushed_ &&
+             std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      ++pushed_;
+      system_->pushSweep(std::move(*scan));
+    }
+  }
+  void fill(Lap& row) override {
+    row.sweeps = processed_.load();
+    row.dropped = system_->stats().sweeps_dropped;
+    row.loops = system_->stats().loops_applied;
+    const pipeline::System::KeyframeMemory kf = system_->keyframeMemory();
+    row.kf_lis = kf.lis;
+    row.kf_loop = kf.loop;
+    system_->inspect([&](const pipeline::LidarOdometry& lis, const pipeline::LoopClosure* loops) {
+      row.keyframes = lis.stats().keyframes;
+      row.retired = lis.stats().keyframes_retired;
+      row.cache = lis.keyframeMap().cacheBytes();
+      if (loops) {
+        row.loop_stats = loops->stats();
+        row.graph_refusals = graphRefusals(*loops);
+        row.descriptors = loops->descriptorBytes();
+      }
+    });
+  }
+  void finish() override { system_->shutdown(); }
+
+ private:
+  std::unique_ptr<pipeline::System> system_;
+  std::atomic<std::size_t> processed_{0};
+  std::size_t pushed_ = 0;
+  std::mutex record_mutex_;
+};
+
+class ReplayRunner : public Runner {
+ public:
+  ReplayRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration)
+      : lis_(odometry, calibration) {
+    lis_.setImuRateListener([this](const StampedPose& p) { record.imu_rate->add(p.t, p.T_world_body); });
+  }
+  void push(Measurement&& m) override {
+    for (const pipeline::ScanOutcome& s : lis_.process(m)) {
+      record.add(s);
+      ++processed_;
+    }
+  }
+  void fill(Lap& row) override {
+    row.sweeps = processed_;
+    row.loops = lis_.stats().loop_times.size();
+    row.keyframes = lis_.stats().keyframes;
+    row.kf_lis = lis_.keyframeBytes();
+    row.retired = lis_.stats().keyframes_retired;
+    row.cache = lis_.keyframeMap().cacheBytes();
+    row.descriptors = lis_.loopClosure().descriptorBytes();
+    row.loop_stats = lis_.loopClosure().stats();
+    row.graph_refusals = graphRefusals(lis_.loopClosure());
+  }
+  void finish() override {
+    for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
+  }
+
+ private:
+  pipeline::LidarOdometry lis_;
+  std::size_t processed_ = 0;
 };
 
 }  // namespace
@@ -54,6 +170,11 @@ int main(int argc, char** argv) {
   const int laps = argc > 1 ? std::stoi(argv[1]) : 6;
   const unsigned seed = argc > 2 ? static_cast<unsigned>(std::stoul(argv[2])) : 1;
   const std::string out_dir = argc > 3 ? argv[3] : "/tmp";
+  const std::string mode = argc > 4 ? argv[4] : "live";
+  if (mode != "live" && mode != "replay") {
+    std::fprintf(stderr, "MODE must be live or replay, not '%s'\n", mode.c_str());
+    return 2;
+  }
   sim::ScenarioOptions so;
   so.seed = seed;
   const sim::Scenario scenario = sim::makeScenario("farm", so);
@@ -61,31 +182,23 @@ int main(int argc, char** argv) {
   sc.enable_camera = false;
   // One IMU period after the lap's last sample: the next lap's first (at rest, at the same pose).
   const Time lap_span = sim::Simulator(scenario, sc, seed).groundTruth().back().t + 5'000'000;
+  const Calibration calibration = sim::Simulator(scenario, sc, seed).calibration();
 
-  std::atomic<std::size_t> processed{0};
-  cli::RunRecord record;
-  record.log.streamTo(out_dir + "/bench_memory_sweeps.jsonl");
-  record.imu_rate = std::make_shared<cli::ImuRateFile>(out_dir + "/bench_memory_imu_rate.tum",
-                                                      Eigen::Isometry3d::Identity());
-  std::mutex record_mutex;
-  pipeline::SystemCallbacks cb;
-  cb.imu_odometry = [&](const pipeline::ImuOdometry& o) { record.imu_rate->add(o.t, o.T_world_imu); };
-  cb.sweep = [&](const pipeline::ScanOutcome& s) {
-    {
-      std::lock_guard<std::mutex> lock(record_mutex);
-      record.add(s);
-    }
-    ++processed;
-  };
-  pipeline::SystemConfig config;
-  config.odometry = farmConfig();
-  config.live.sweep_queue = 4;
-  pipeline::System system(config, sim::Simulator(scenario, sc, seed).calibration(), cb);
+  std::unique_ptr<Runner> runner;
+  if (mode == "live") {
+    runner = std::make_unique<LiveRunner>(farmConfig(), calibration);
+  } else {
+    runner = std::make_unique<ReplayRunner>(farmConfig(), calibration);
+  }
+  runner->record.log.streamTo(out_dir + "/bench_memory_sweeps.jsonl");
+  runner->record.imu_rate =
+      std::make_shared<cli::ImuRateFile>(out_dir + "/bench_memory_imu_rate.tum", Eigen::Isometry3d::Identity());
 
   std::vector<Lap> rows;
   const auto wall0 = std::chrono::steady_clock::now();
-  std::size_t pushed = 0;
-  std::printf("lap  data_s  wall_s  sweeps  keyframes  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  kf_loop_MB\n");
+  std::printf("%s: lap  data_s  wall_s  sweeps  keyframes  retired  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  "
+              "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms\n",
+              mode.c_str());
   for (int lap = 0; lap < laps; ++lap) {
     const Time offset = lap * lap_span;
     // Each lap its own noise (seed + lap); the same world and path: the robot drives the same course again.
@@ -93,49 +206,41 @@ int main(int argc, char** argv) {
     simulator.run([&](Measurement&& m) {
       if (auto* imu = std::get_if<ImuSample>(&m)) {
         imu->t += offset;
-        system.pushImu(*imu);
       } else if (auto* scan = std::get_if<LidarScan>(&m)) {
         scan->t += offset;
         scan->t_end += offset;
-        const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(500);
-        while (processed.load() + system.stats().sweeps_dropped + 1 < pushed &&
-               std::chrono::steady_clock::now() < deadline)
-          std::this_thread::sleep_for(std::chrono::microseconds(200));
-        ++pushed;
-        system.pushSweep(std::move(*scan));
       }
+      runner->push(std::move(m));
     });
     Lap row;
     row.lap = lap + 1;
     row.data_s = toSeconds((lap + 1) * lap_span);
     row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    runner->fill(row);
     row.rss_kb = statusKb("VmRSS");
     row.peak_kb = statusKb("VmHWM");
-    row.sweeps = processed.load();
-    row.dropped = system.stats().sweeps_dropped;
-    row.loops = system.stats().loops_applied;
-    row.kf = system.keyframeMemory();
-    system.inspect([&](const pipeline::LidarOdometry& lis, const pipeline::LoopClosure*) {
-      row.keyframes = lis.stats().keyframes;
-    });
     rows.push_back(row);
-    std::printf("%3d  %6.0f  %6.0f  %6zu  %9zu  %5zu  %7zu  %6.1f  %7.1f  %9.1f  %10.1f\n", row.lap, row.data_s,
-                row.wall_s, row.sweeps, row.keyframes, row.loops, row.dropped, row.rss_kb / 1024.0,
-                row.peak_kb / 1024.0, row.kf.lis / 1048576.0, row.kf.loop / 1048576.0);
+    const pipeline::LoopStats& ls = row.loop_stats;
+    std::printf("%3d  %6.0f  %6.0f  %6zu  %9zu  %7zu  %5zu  %7zu  %6.1f  %7.1f  %9.1f  %10.1f  %8.1f  %5.1f  | %8zu  "
+                "%8zu  %11zu  %13zu  %8.0f\n",
+                row.lap, row.data_s, row.wall_s, row.sweeps, row.keyframes, row.retired, row.loops, row.dropped,
+                row.rss_kb / 1024.0, row.peak_kb / 1024.0, row.kf_lis / 1048576.0, row.kf_loop / 1048576.0,
+                row.cache / 1048576.0, row.descriptors / 1048576.0, ls.verified, ls.accepted, ls.over_drift_budget,
+                row.graph_refusals, ls.graph_ms);
     std::fflush(stdout);
   }
-  system.shutdown();
+  runner->finish();
   const Lap& first = rows.front();
   const Lap& last = rows.back();
   const auto mb = [](double kb) { return kb / 1024.0; };
-  const double kf_first = (first.kf.lis + first.kf.loop) / 1024.0, kf_last = (last.kf.lis + last.kf.loop) / 1024.0;
+  const double kf_first = (first.kf_lis + first.kf_loop) / 1024.0, kf_last = (last.kf_lis + last.kf_loop) / 1024.0;
   std::printf("\npeak after lap 1 (the 10-minute course): %.1f MB, of which keyframe clouds %.1f MB\n",
               mb(first.peak_kb), mb(kf_first));
   std::printf("peak after lap %d (%.0f min of data): %.1f MB, of which keyframe clouds %.1f MB\n", last.lap,
               last.data_s / 60, mb(last.peak_kb), mb(kf_last));
   std::printf("ratio of peaks: %.2f overall, %.2f without the keyframe clouds\n",
               static_cast<double>(last.peak_kb) / first.peak_kb, (last.peak_kb - kf_last) / (first.peak_kb - kf_first));
-  std::printf("records streamed: %zu sweep lines, %zu IMU-rate poses\n", record.log.lines(),
-              record.imu_rate->copyTo(out_dir + "/bench_memory_imu_rate.tum").poses);
+  std::printf("records streamed: %zu sweep lines, %zu IMU-rate poses\n", runner->record.log.lines(),
+              runner->record.imu_rate->copyTo(out_dir + "/bench_memory_imu_rate.tum").poses);
   return 0;
 }

@@ -87,6 +87,7 @@ Json statsJson(const pipeline::OdometryStats& s, const RunRecord& r) {
   j["points_dropped"] = s.points_dropped;
   j["points_nonfinite"] = s.points_nonfinite;
   j["keyframes"] = s.keyframes;
+  j["keyframes_retired"] = s.keyframes_retired;
   j["degenerate_scans"] = s.degenerate_scans;
   j["not_converged"] = s.not_converged;
   j["smoother_resets"] = s.smoother_resets;

@@ -156,6 +156,7 @@ pipeline::SystemCallbacks LiveSession::Impl::systemCallbacks() {
     std::lock_guard<std::mutex> lock(record_mutex);
     if (keyframe_clouds.size() <= k.index) keyframe_clouds.resize(k.index + 1);
     keyframe_clouds[k.index] = k.features;
+    for (std::size_t i : k.retired) keyframe_clouds[i].reset();  // a newer keyframe stands for the place
   };
   s.loop = [this](const pipeline::LoopCorrection& c) {
     if (cb.loop) cb.loop(LoopLink{c.event.query, c.event.candidate, c.event.t_query, c.event.t_candidate});

@@ -46,7 +46,9 @@ std::string LocalMapConfig::validate() const {
   }
   for (const auto& [name, value] : {std::pair<const char*, double>{"keyframe_density", keyframe_density},
                                     {"recent_window", recent_window},
-                                    {"full_leaf", full_leaf}}) {
+                                    {"full_leaf", full_leaf},
+                                    {"retire_radius", retire_radius},
+                                    {"retire_age", retire_age}}) {
     if (std::string error = checkNonNegative(name, value); !error.empty()) return error;
   }
   if (recent_count < 0) return "local map recent_count must be >= 0, got " + std::to_string(recent_count);
@@ -72,6 +74,7 @@ struct LocalMap::Impl {
   PointCloud planes_world;
   std::unique_ptr<detail::CloudKdTree> edge_tree;
   std::unique_ptr<detail::CloudKdTree> plane_tree;
+  std::size_t retired = 0;
 
   const Keyframe& at(std::size_t index) const {
     if (index >= keyframes.size()) {
@@ -125,6 +128,40 @@ void LocalMap::updatePose(std::size_t index, const Eigen::Isometry3d& T_world_li
   ++impl_->pose_version;
 }
 
+std::vector<std::size_t> LocalMap::supersededBy(std::size_t index) const {
+  const Keyframe& newer = impl_->at(index);
+  std::vector<std::size_t> out;
+  if (config_.retire_radius <= 0.0) return out;
+  const Time latest = newer.t - fromSeconds(config_.retire_age);
+  const Eigen::Vector3d p = newer.T_world_lidar.translation();
+  for (std::size_t i = 0; i < index && impl_->keyframes[i].t <= latest; ++i) {
+    const Keyframe& older = impl_->keyframes[i];
+    if (!older.retired && (older.T_world_lidar.translation() - p).norm() <= config_.retire_radius) out.push_back(i);
+  }
+  return out;
+}
+
+void LocalMap::retire(std::size_t index) {
+  impl_->at(index);
+  Keyframe& kf = impl_->keyframes[index];
+  if (kf.retired) return;
+  auto empty = std::make_shared<FeatureSet>();
+  empty->t = kf.t;
+  kf.shared = std::move(empty);
+  kf.retired = true;
+  ++impl_->retired;
+  impl_->cache.erase(index);
+}
+
+std::size_t LocalMap::retiredCount() const { return impl_->retired; }
+
+std::size_t LocalMap::cacheBytes() const {
+  std::size_t bytes = 0;
+  for (const auto& [index, entry] : impl_->cache)
+    bytes += (entry.edges_world.capacity() + entry.planes_world.capacity()) * sizeof(Eigen::Vector3f);
+  return bytes;
+}
+
 namespace {
 
 // Surrounding keyframes thinned to the newest per density cube, plus the recent ones; ascending indices.
@@ -136,7 +173,7 @@ std::vector<std::size_t> selectKeyframes(const std::vector<Keyframe>& keyframes,
   for (std::size_t k = first; k < keyframes.size(); ++k) {
     const Keyframe& kf = keyframes[k];
     const Eigen::Vector3d p = kf.T_world_lidar.translation();
-    if ((p - center).norm() > config.surrounding_radius) continue;
+    if (kf.retired || (p - center).norm() > config.surrounding_radius) continue;
     if (config.keyframe_density <= 0.0) {
       selected.push_back(kf.index);
       continue;
@@ -151,7 +188,7 @@ std::vector<std::size_t> selectKeyframes(const std::vector<Keyframe>& keyframes,
     const bool in_window = config.recent_window > 0.0 &&
                            toSeconds(newest.t - keyframes[i].t) <= config.recent_window;
     const bool in_count = i + static_cast<std::size_t>(config.recent_count) >= keyframes.size();
-    if (in_window || in_count) selected.push_back(i);
+    if ((in_window || in_count) && !keyframes[i].retired) selected.push_back(i);
   }
   std::sort(selected.begin(), selected.end());
   selected.erase(std::unique(selected.begin(), selected.end()), selected.end());

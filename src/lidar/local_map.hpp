@@ -34,6 +34,13 @@ struct LocalMapConfig {
   double full_leaf = 0.0;            // [m] voxel leaf applied to a keyframe's full cloud when stored; 0 keeps it
   int cache_capacity = 1000;         // [keyframes] world-frame clouds cached at most (LIO-SAM clears at 1000);
                                      // the keyframes of the current local map are never evicted
+  // A map bounded by the area driven, not the time (a robot that drives the same barn all day): once a keyframe
+  // is retire_age old, the keyframes at least retire_age older than it within retire_radius of it are retired:
+  // their clouds are freed (their poses stay, for the trajectory and the pose graph) and the newer view of the
+  // place stands for them, as it already does in the local maps (the newest keyframe per density cube). LIO-SAM
+  // keeps every keyframe's clouds: retire_radius 0.
+  double retire_radius = 1.0;        // [m] (LIO-SAM's keyframe spacing); 0 keeps every keyframe's clouds
+  double retire_age = 30.0;          // [s] (as the loop search's min_age, LIO-SAM's 30 s): another pass
   // Empty when valid: every value finite, radius > 0, the others >= 0, edge/plane leaves > 0, capacity >= 1.
   std::string validate() const;
 };
@@ -46,6 +53,7 @@ struct Keyframe {
   // Lidar frame, downsampled with the map's leaves; immutable, so other maps (the live loop thread's) share it
   // instead of holding a copy.
   std::shared_ptr<const FeatureSet> shared;
+  bool retired = false;  // its clouds were freed (LocalMap::retire): features() is empty, local maps skip it
   const FeatureSet& features() const { return *shared; }
 };
 
@@ -78,6 +86,17 @@ class LocalMap {
   // Corrects a keyframe's pose (loop closure); its cached world clouds are dropped and the next build()
   // reassembles. Throws std::invalid_argument on a bad index or non-finite pose.
   void updatePose(std::size_t index, const Eigen::Isometry3d& T_world_lidar);
+
+  // The keyframes keyframe `index` supersedes (see retire_radius): not retired, at least retire_age older than it,
+  // within retire_radius of its current position; ascending. Empty when retire_radius is 0. Throws
+  // std::invalid_argument on a bad index.
+  std::vector<std::size_t> supersededBy(std::size_t index) const;
+  // Frees a keyframe's clouds for good (its pose, time and index stay); local maps skip it from then on. Retiring
+  // twice is harmless. Throws std::invalid_argument on a bad index.
+  void retire(std::size_t index);
+  std::size_t retiredCount() const;
+  // [bytes] the world-frame clouds cached for local maps (bounded by cache_capacity)
+  std::size_t cacheBytes() const;
 
   // Assembles the local map around `center_world` [m] (usually the last keyframe's or the guess's position) from
   // the keyframes with index >= first_keyframe (the odometry starts a new submap there after a long degenerate

@@ -37,6 +37,8 @@ struct ScanContextDatabase::Impl {
   std::vector<int> ids;                    // by entry
   std::vector<ScanContext> descriptors;    // by entry
   std::vector<Eigen::VectorXf> ring_keys;  // by entry (the tree reads them)
+  std::vector<bool> removed;               // by entry
+  std::size_t removed_count = 0;
   std::unordered_map<int, std::size_t> entry_of_id;
   RingKeyAdaptor adaptor;
   std::unique_ptr<RingKeyTree> tree;
@@ -69,12 +71,15 @@ void ScanContextDatabase::add(int id, ScanContext descriptor) {
   m.ids.push_back(id);
   m.ring_keys.push_back(descriptor.ring_key);
   m.descriptors.push_back(std::move(descriptor));
+  m.removed.push_back(false);
   // Entries older than the exclusion window become searchable.
   const std::size_t ready = m.ids.size() > static_cast<std::size_t>(config_.exclude_recent)
                                 ? m.ids.size() - static_cast<std::size_t>(config_.exclude_recent)
                                 : 0;
   if (ready > m.indexed) {
     m.tree->addPoints(static_cast<std::uint32_t>(m.indexed), static_cast<std::uint32_t>(ready - 1));
+    for (std::size_t e = m.indexed; e < ready; ++e)  // removed before they became searchable
+      if (m.removed[e]) m.tree->removePoint(e);
     m.indexed = ready;
   }
 }
@@ -135,6 +140,30 @@ DatabaseQuery ScanContextDatabase::query(const AugmentedScanContext& q,
   return out;
 }
 
+void ScanContextDatabase::remove(int id) {
+  Impl& m = *impl_;
+  const auto it = m.entry_of_id.find(id);
+  if (it == m.entry_of_id.end())
+    throw std::invalid_argument("scan context database: cannot remove unknown id " + std::to_string(id));
+  const std::size_t e = it->second;
+  if (m.removed[e]) return;
+  m.removed[e] = true;
+  ++m.removed_count;
+  m.descriptors[e] = ScanContext{};  // the ring key stays: the tree reads it when it rebuilds its sub-trees
+  if (e < m.indexed) m.tree->removePoint(e);
+}
+
+std::size_t ScanContextDatabase::removed() const { return impl_->removed_count; }
+
+std::size_t ScanContextDatabase::descriptorBytes() const {
+  std::size_t bytes = 0;
+  for (const ScanContext& d : impl_->descriptors)
+    bytes += sizeof(float) * static_cast<std::size_t>(d.image.size() + d.occupied.size() + d.ring_key.size() +
+                                                      d.sector_key.size() + d.unit_columns.size() +
+                                                      d.column_norms.size());
+  return bytes;
+}
+
 std::size_t ScanContextDatabase::size() const { return impl_->ids.size(); }
 std::size_t ScanContextDatabase::searchable() const { return impl_->indexed; }
 
@@ -142,6 +171,8 @@ const ScanContext& ScanContextDatabase::descriptor(int id) const {
   auto it = impl_->entry_of_id.find(id);
   if (it == impl_->entry_of_id.end())
     throw std::invalid_argument("scan context database: unknown id " + std::to_string(id));
+  if (impl_->removed[it->second])
+    throw std::invalid_argument("scan context database: id " + std::to_string(id) + " was removed");
   return impl_->descriptors[it->second];
 }
 

@@ -59,9 +59,15 @@ class ScanContextDatabase {
   DatabaseQuery query(const AugmentedScanContext& query,
                       const std::function<std::optional<double>(int id)>& yaw_prior = {}) const;
 
-  std::size_t size() const;                     // entries stored
+  // Drops entry `id` for good (its keyframe's clouds were retired, a newer keyframe stands for the place): it is
+  // never a candidate again and its descriptor is freed. Removing twice is harmless; an unknown id throws
+  // std::invalid_argument.
+  void remove(int id);
+  std::size_t size() const;                     // entries stored, removed ones included
+  std::size_t removed() const;                  // entries removed
   std::size_t searchable() const;               // entries old enough to be returned
-  const ScanContext& descriptor(int id) const;  // throws std::invalid_argument for an unknown id
+  const ScanContext& descriptor(int id) const;  // throws std::invalid_argument for an unknown or removed id
+  std::size_t descriptorBytes() const;          // [bytes] the stored descriptors' matrices and ring keys
   const ScanContextDatabaseConfig& config() const { return config_; }
 
  private:

@@ -50,6 +50,8 @@ std::size_t LidarOdometry::keyframeBytes() const {
   return bytes;
 }
 
+const lidar::LocalMap& LidarOdometry::keyframeMap() const { return impl_->map; }
+
 Trajectory LidarOdometry::keyframeTrajectory() const {
   Trajectory out;
   for (std::size_t i = 0; i < impl_->map.size(); ++i)

@@ -70,6 +70,7 @@ struct OdometryStats {
   std::size_t points_dropped = 0;        // non-finite or out-of-range points removed (by the reader or sanitize)
   std::size_t points_nonfinite = 0;      // of which NaN/inf (a warning on each sweep that had any)
   std::size_t keyframes = 0;
+  std::size_t keyframes_retired = 0;     // clouds freed: a newer keyframe stands for the place (retire_radius)
   std::size_t degenerate_scans = 0;
   std::size_t not_converged = 0;         // matches that stopped without converging (pose kept from the guess)
   std::size_t smoother_resets = 0;
@@ -94,6 +95,9 @@ struct KeyframeRecord {
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();     // the LIS's estimate when it was made
   Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();   // relative to the previous keyframe
   geometry::Matrix6d degenerate_cov = geometry::Matrix6d::Zero();      // as LoopClosure::addKeyframe takes it
+  // Older keyframes this one's arrival retired (LocalMap::supersededBy, decided with the LIS's poses now): a copy of
+  // the map retires them too, after this keyframe's loop search (LoopClosure::retire as well).
+  std::vector<std::size_t> retired;
 };
 
 // Keyframe poses corrected by an accepted loop (LIO-SAM's correctPoses input): T_world_lidar of keyframes
@@ -131,6 +135,7 @@ class LidarOdometry {
   void setImuRateListener(ImuRateListener listener);
   const std::deque<StampedPose>& recentImuRate() const;
   std::size_t keyframeBytes() const;  // [bytes] the keyframe map's feature clouds
+  const lidar::LocalMap& keyframeMap() const;  // every keyframe (retired ones marked), poses as corrected
   // The keyframes' full clouds in the world frame, voxel-downsampled with leaf [m].
   lidar::PointCloud mapCloud(float leaf) const;
   const OdometryStats& stats() const;

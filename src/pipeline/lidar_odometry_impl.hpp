@@ -40,6 +40,7 @@ struct LidarOdometry::Impl {
   geometry::Matrix6d degenerate_since_kf = geometry::Matrix6d::Zero();  // sum of d d^T since the last keyframe
   int degenerate_run = 0;               // consecutive degenerate sweeps
   std::size_t map_first_keyframe = 0;   // the local map uses keyframes from this index on (submap start)
+  std::size_t retire_next = 0;          // the next keyframe to retire the keyframes it supersedes (when old enough)
   SweepListener sweep_listener;         // the VIS's lidar depth (setSweepListener)
   KeyframeListener keyframe_listener;   // live: loop closure elsewhere, map updates (setKeyframeListener)
   bool external_loops = false;
@@ -75,6 +76,7 @@ struct LidarOdometry::Impl {
     if (stats.notices.size() < OdometryStats::kMaxNotices) stats.notices.push_back(std::move(line));
   }
   void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
+  std::vector<std::size_t> supersededKeyframes();
   void accumulateDegeneracy(const ScanOutcome& out);
   void applyLoopCorrection(ScanOutcome& out);
   Eigen::Isometry3d correctKeyframes(const std::vector<Eigen::Isometry3d>& poses);

@@ -2,6 +2,7 @@
 // features, the scan-to-map match, the IMU smoother, keyframes and in-line loop closure.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "pipeline/lidar_odometry_impl.hpp"
@@ -219,15 +220,38 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
   out.keyframe = true;
   ++stats.keyframes;
   const auto t0 = Clock::now();
+  std::vector<std::size_t> retired = supersededKeyframes();
   if (keyframe_listener) {
     const Eigen::Isometry3d T_previous = index > 0 ? map.keyframe(index - 1).T_world_lidar : out.T_world_lidar;
     keyframe_listener(KeyframeRecord{index, out.t, map.keyframe(index).shared, out.T_world_lidar,
-                                     T_previous.inverse() * out.T_world_lidar, degenerate_since_kf});
+                                     T_previous.inverse() * out.T_world_lidar, degenerate_since_kf, retired});
   }
   const bool closed = !external_loops && loops.addKeyframe(map, index, degenerate_since_kf);
   degenerate_since_kf.setZero();
   if (closed) applyLoopCorrection(out);
+  // After the search, as the live loop thread does it: this keyframe's search still saw the retired ones.
+  for (std::size_t i : retired) {
+    map.retire(i);
+    if (!external_loops) loops.retire(i);
+  }
+  stats.keyframes_retired += retired.size();
   out.ms.loop = msSince(t0);
+}
+
+// The keyframes superseded by those that became retire_age old with the newest keyframe (LocalMapConfig): each
+// keyframe is looked at once, when it is that old, so its own loop search has long been made.
+std::vector<std::size_t> LidarOdometry::Impl::supersededKeyframes() {
+  std::vector<std::size_t> out;
+  const std::size_t newest = map.size() - 1;
+  if (map.config().retire_radius <= 0) return out;
+  const Time latest = map.keyframe(newest).t - fromSeconds(map.config().retire_age);
+  for (; retire_next < newest && map.keyframe(retire_next).t <= latest; ++retire_next) {
+    const std::vector<std::size_t> superseded = map.supersededBy(retire_next);
+    out.insert(out.end(), superseded.begin(), superseded.end());
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 // What the pose graph is told about the sweeps between keyframes: each degenerate direction (and every direction

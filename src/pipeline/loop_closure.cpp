@@ -190,6 +190,7 @@ std::optional<Candidate> LoopClosure::Impl::radiusCandidate(const lidar::LocalMa
   std::optional<Candidate> best;
   double best_d = config.radius;
   for (std::size_t i = 0; i < index && times[i] <= newest; ++i) {
+    if (map.keyframe(i).retired) continue;
     const double d = (map.keyframe(i).T_world_lidar.translation() - T_world_query.translation()).norm();
     if (d < best_d) {
       best_d = d;
@@ -208,6 +209,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
   std::vector<loop::SubmapKeyframe> submap;
   std::size_t candidate_in_submap = 0;
   for (std::size_t i = first; i <= c.index + n && i < index && times[i] <= newest; ++i) {
+    if (map.keyframe(i).retired) continue;  // its clouds are gone (a candidate never is)
     if (i == c.index) candidate_in_submap = submap.size();
     submap.push_back({&map.keyframe(i).features(), map.keyframe(i).T_world_lidar});
   }
@@ -276,6 +278,15 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
 }
 
 void LoopClosure::setVisualYawPrior(VisualYawPrior prior) { impl_->visual_prior = std::move(prior); }
+
+void LoopClosure::retire(std::size_t index) {
+  if (index >= impl_->times.size())
+    throw std::invalid_argument(fmt::format("loop closure: cannot retire keyframe {} of {}", index, impl_->times.size()));
+  if (impl_->config.enabled) impl_->database.remove(static_cast<int>(index));
+  ++impl_->stats.retired;
+}
+
+std::size_t LoopClosure::descriptorBytes() const { return impl_->database.descriptorBytes(); }
 
 std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
   std::vector<Eigen::Isometry3d> out;

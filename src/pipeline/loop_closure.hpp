@@ -76,6 +76,7 @@ struct LoopStats {
   std::size_t over_drift_budget = 0;                 // verified by scan matching but rejected by the drift budget
   std::size_t narrowed_searches = 0, fallbacks = 0;  // prior-narrowed shift searches, and their fall-backs
   std::size_t visual_priors = 0;                     // shift searches whose prior came from the VisualYawPrior
+  std::size_t retired = 0;                           // keyframes retired (retire()): no longer candidates
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
 };
 
@@ -100,6 +101,10 @@ class LoopClosure {
   // The shift search's prior comes from `prior` when it returns one, else from the current estimate (when
   // config.yaw_prior). An empty function removes it. The VIS fills this in later; until then only the estimate.
   void setVisualYawPrior(VisualYawPrior prior);
+  // Keyframe `index` was retired from the map (LocalMap::retire): its Scan Context leaves the database, and it is
+  // no longer a radius candidate (its graph node stays). Call after retiring it in the map given to addKeyframe.
+  void retire(std::size_t index);
+  std::size_t descriptorBytes() const;  // [bytes] the database's stored descriptors
 
   std::vector<Eigen::Isometry3d> poses() const;  // T_world_lidar of every keyframe from the graph, by index
   bool searched(std::size_t index) const;        // keyframe `index` was queried for loops (not skipped)

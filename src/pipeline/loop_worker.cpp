@@ -14,6 +14,15 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
   const Eigen::Isometry3d T_world_lidar =
       kf.index == 0 ? kf.T_world_lidar : map_.keyframe(kf.index - 1).T_world_lidar * kf.T_previous_this;
   map_.addSharedKeyframe(kf.features, T_world_lidar);  // the LIS's own clouds, not a copy
+  std::optional<LoopCorrection> c = search(kf);
+  for (std::size_t i : kf.retired) {  // after the search, as the in-line loop closure does
+    map_.retire(i);
+    loops_.retire(i);
+  }
+  return c;
+}
+
+std::optional<LoopCorrection> LoopWorker::search(const KeyframeRecord& kf) {
   if (!loops_.addKeyframe(map_, kf.index, kf.degenerate_cov)) return std::nullopt;
   LoopCorrection c;
   c.poses = loops_.poses();

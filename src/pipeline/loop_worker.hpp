@@ -19,7 +19,7 @@ class LoopWorker {
   LoopWorker(const LoopClosureConfig& loop, const lidar::LocalMapConfig& map);
 
   // The next keyframe (indices 0, 1, 2, ... in order, else std::invalid_argument). Returns the corrected poses
-  // of keyframes 0..index when it closed a loop.
+  // of keyframes 0..index when it closed a loop. The keyframes it retired are retired here after its search.
   std::optional<LoopCorrection> add(const KeyframeRecord& keyframe);
 
   std::size_t keyframes() const { return map_.size(); }
@@ -28,6 +28,7 @@ class LoopWorker {
   const LoopClosure& loopClosure() const { return loops_; }
 
  private:
+  std::optional<LoopCorrection> search(const KeyframeRecord& keyframe);
   lidar::LocalMap map_;
   LoopClosure loops_;
 };

@@ -182,6 +182,7 @@ TEST(OdometryConfigReader, EveryLocalMapMatcherAndKeyframeKeyReachesItsOwnField)
       dir,
       "odometry:\n  local_map:\n    surrounding_radius: 40\n    keyframe_density: 1.5\n    recent_window: 5\n"
       "    recent_count: 3\n    edge_leaf: 0.15\n    plane_leaf: 0.35\n    full_leaf: 0.05\n    cache_capacity: 500\n"
+      "    retire_radius: 0.7\n    retire_age: 45\n"
       "  matcher:\n    max_iterations: 12\n    convergence_translation: 0.001\n    convergence_rotation: 0.002\n"
       "    neighbors: 6\n    max_neighbor_distance: 1.5\n    edge_eigen_ratio: 4\n    plane_tolerance: 0.15\n"
       "    kernel: huber\n    min_weight: 0.2\n    huber_delta: 0.05\n    degeneracy_threshold: 50\n"
@@ -196,6 +197,8 @@ TEST(OdometryConfigReader, EveryLocalMapMatcherAndKeyframeKeyReachesItsOwnField)
   EXPECT_DOUBLE_EQ(m.plane_leaf, 0.35);
   EXPECT_DOUBLE_EQ(m.full_leaf, 0.05);
   EXPECT_EQ(m.cache_capacity, 500);
+  EXPECT_DOUBLE_EQ(m.retire_radius, 0.7);
+  EXPECT_DOUBLE_EQ(m.retire_age, 45.0);
   const lidar::ScanMatcherConfig& s = c.matcher;
   EXPECT_EQ(s.max_iterations, 12);
   EXPECT_DOUBLE_EQ(s.convergence_translation, 0.001);

@@ -201,7 +201,59 @@ TEST(LocalMap, RejectsBadConfigIndicesAndPoses) {
   EXPECT_THROW(map.updatePose(1, at(1.0)), std::invalid_argument);
   EXPECT_THROW(map.updatePose(0, bad), std::invalid_argument);
   EXPECT_THROW(map.keyframe(3), std::invalid_argument);
+  EXPECT_THROW(map.retire(1), std::invalid_argument);
+  EXPECT_THROW(map.supersededBy(1), std::invalid_argument);
   EXPECT_EQ(map.poses().size(), 1u);
+  config = {};
+  config.retire_radius = -1.0;
+  EXPECT_NE(config.validate().find("retire_radius"), std::string::npos);
+  config = {};
+  config.retire_age = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(config.validate().find("retire_age"), std::string::npos);
+}
+
+// A corridor driven twice, keyframes every metre: the first pass at t = 0..9 s, the second at t = 100..109 s,
+// 0.3 m to the side and half a metre along. Each second-pass keyframe supersedes the first-pass ones within 1 m
+// that are at least 60 s older; none of its own pass.
+TEST(LocalMap, AKeyframeSupersedesTheOlderPassesKeyframesWithinTheRetireRadius) {
+  LocalMapConfig config;
+  config.retire_radius = 1.0;  // [m]
+  config.retire_age = 60.0;    // [s]
+  LocalMap map(config);
+  for (int i = 0; i < 10; ++i) map.addKeyframe(patch(i), at(i));
+  for (int i = 0; i < 10; ++i) map.addKeyframe(patch(100.0 + i), at(i + 0.5, 0.3));
+  // Keyframe 12 at (2.5, 0.3): first-pass keyframes 2 (0.58 m) and 3 (0.58 m); 1 and 4 are 1.54 m away.
+  EXPECT_EQ(map.supersededBy(12), (std::vector<std::size_t>{2, 3}));
+  EXPECT_TRUE(map.supersededBy(5).empty()) << "its own pass is never older by 60 s";
+  config.retire_radius = 0.0;
+  LocalMap keeps_all(config);
+  for (int i = 0; i < 2; ++i) keeps_all.addKeyframe(patch(100.0 * i), at(0.0));
+  EXPECT_TRUE(keeps_all.supersededBy(1).empty()) << "retire_radius 0 keeps every keyframe";
+}
+
+TEST(LocalMap, ARetiredKeyframeLosesItsCloudsKeepsItsPoseAndLeavesTheLocalMap) {
+  LocalMapConfig config;
+  config.recent_window = 0.0;
+  config.keyframe_density = 0.0;
+  LocalMap map(config);
+  map.addKeyframe(patch(0.0), at(0.0));
+  map.addKeyframe(patch(100.0, 400, 2), at(0.4));
+  EXPECT_EQ(map.build(Eigen::Vector3d::Zero()).keyframes, (std::vector<std::size_t>{0, 1}));
+  const std::size_t cached = map.cacheBytes();
+  EXPECT_GT(cached, 0u);
+  const std::shared_ptr<const FeatureSet> before = map.keyframe(0).shared;
+  map.retire(0);
+  map.retire(0);  // twice: harmless
+  EXPECT_EQ(map.retiredCount(), 1u);
+  EXPECT_TRUE(map.keyframe(0).retired);
+  EXPECT_TRUE(map.keyframe(0).features().edges.empty() && map.keyframe(0).features().planes.empty() &&
+              map.keyframe(0).features().full.empty());
+  EXPECT_EQ(before.use_count(), 1) << "the map no longer holds the old clouds";
+  EXPECT_EQ(map.keyframe(0).t, fromSeconds(0.0));
+  EXPECT_TRUE(map.keyframe(0).T_world_lidar.isApprox(at(0.0)));
+  EXPECT_LT(map.cacheBytes(), cached);
+  EXPECT_EQ(map.build(Eigen::Vector3d::Zero()).keyframes, (std::vector<std::size_t>{1}));
+  EXPECT_TRUE(map.supersededBy(1).empty()) << "a retired keyframe is not superseded again";
 }
 
 }  // namespace

@@ -93,6 +93,36 @@ TEST(ScanContextDatabase, AYawPriorNarrowsEachCandidatesSearchToSevenShifts) {
     EXPECT_TRUE(narrowed.candidates[i].match.match.fell_back);
 }
 
+// Removal (a retired keyframe): an entry removed after it became searchable, and one removed while still among the
+// newest, are never returned again; their descriptors are freed; the place a removed entry stood for is found in
+// the entry that replaced it.
+TEST(ScanContextDatabase, RemovedEntriesAreNeverCandidatesAgainAndTheirDescriptorsAreFreed) {
+  ScanContextDatabase db(config(3));
+  const ScanContextConfig& d = db.config().descriptor;
+  for (int id = 0; id < 10; ++id) db.add(id, makeScanContext(place(id), d));
+  const std::size_t bytes = db.descriptorBytes();
+  db.remove(2);  // searchable already (entries 0..6 are)
+  db.remove(8);  // still among the 3 newest
+  db.remove(8);  // twice: harmless
+  EXPECT_EQ(db.removed(), 2u);
+  EXPECT_EQ(db.size(), 10u);
+  EXPECT_LT(db.descriptorBytes(), bytes * 9 / 10);
+  EXPECT_THROW(db.descriptor(2), std::invalid_argument);
+  EXPECT_THROW(db.remove(99), std::invalid_argument);
+  db.add(10, makeScanContext(place(2), d));  // the same place, seen again
+  for (int id = 11; id < 15; ++id) db.add(id, makeScanContext(place(id), d));  // 8 and 10 become searchable
+  for (int id : {2, 8}) {
+    for (const LoopCandidate& c : db.query(makeAugmentedScanContext(place(id), d)).candidates) {
+      EXPECT_NE(c.id, 2);
+      EXPECT_NE(c.id, 8);
+    }
+  }
+  const DatabaseQuery r = db.query(makeAugmentedScanContext(place(2), d));
+  ASSERT_FALSE(r.candidates.empty());
+  EXPECT_EQ(r.candidates[0].id, 10);
+  EXPECT_LT(r.candidates[0].match.match.distance, 1e-3);
+}
+
 TEST(ScanContextDatabase, RejectsDescriptorsOfAnotherShapeDuplicateIdsAndBadConfigs) {
   ScanContextDatabase db(config(0));
   ScanContextConfig other = db.config().descriptor;

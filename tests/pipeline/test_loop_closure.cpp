@@ -3,6 +3,8 @@
 // one, with the true relative pose, and the trajectory stays accurate.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <numbers>
 
@@ -187,6 +189,8 @@ struct OverlapRun {
   double ape = 0;          // [m] rmse, SE(3)-aligned
   std::vector<LoopEvent> events;
   LoopStats stats;
+  OdometryStats odometry;
+  std::vector<lidar::Keyframe> keyframes;  // as they ended (poses corrected, the retired ones marked)
 };
 
 double apeRmse(const Trajectory& truth, const Trajectory& est) {
@@ -207,6 +211,7 @@ const OverlapRun& overlap() {
     config.layout.min_range = config.features.min_range = 0.8;
     config.features.surf_leaf = 0.2f;
     config.local_map.plane_leaf = 0.2;
+    config.local_map.retire_age = 20.0;  // [s] the second pass ends 28 s after it begins
     OverlapRun out;
     const Eigen::Isometry3d T_imu_lidar = simulator.calibration().T_imu_lidar;
     for (const StampedPose& p : simulator.groundTruth()) out.lidar_truth.push_back({p.t, p.T_world_body * T_imu_lidar});
@@ -216,6 +221,8 @@ const OverlapRun& overlap() {
     out.ape = apeRmse(out.lidar_truth, odometry.trajectory());
     out.events = odometry.loopClosure().events();
     out.stats = odometry.loopClosure().stats();
+    out.odometry = odometry.stats();
+    for (std::size_t i = 0; i < odometry.keyframeMap().size(); ++i) out.keyframes.push_back(odometry.keyframeMap().keyframe(i));
     return out;
   }();
   return run;
@@ -245,6 +252,22 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectorySt
   // Without loops this course gives 0.016 m (the lidar-inertial odometry alone is good here); the loops must not
   // spoil it. (One test: ctest runs each test in its own process, and the course takes ~15 s.)
   EXPECT_LT(r.ape, 0.05);
+  // The second pass supersedes the first where it drives it again (LocalMapConfig::retire_radius, 1 m, here 20 s):
+  // each retired keyframe has a keyframe at least 20 s newer within 1 m (its corrected pose: 1.1 m).
+  std::printf("overlap: %zu keyframes, %zu retired\n", r.keyframes.size(), r.odometry.keyframes_retired);
+  EXPECT_GE(r.odometry.keyframes_retired, 5u);
+  std::size_t retired = 0;
+  for (const lidar::Keyframe& old : r.keyframes) {
+    if (!old.retired) continue;
+    ++retired;
+    EXPECT_TRUE(old.features().full.empty());
+    const bool superseded = std::any_of(r.keyframes.begin(), r.keyframes.end(), [&](const lidar::Keyframe& k) {
+      return k.t >= old.t + fromSeconds(20.0) &&
+             (k.T_world_lidar.translation() - old.T_world_lidar.translation()).norm() < 1.1;
+    });
+    EXPECT_TRUE(superseded) << "keyframe " << old.index;
+  }
+  EXPECT_EQ(retired, r.odometry.keyframes_retired);
 }
 
 }  // namespace

@@ -165,6 +165,7 @@ TEST(System, StateAccessorsRefuseBeforeShutdownAndPushesAfterItAreIgnored) {
 TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   const Course course = simulate("overlap", 70.0, 3);
   OdometryConfig config = simConfig();
+  config.local_map.retire_age = 8.0;  // [s] so that the start, driven again at ~60 s, retires keyframes here
   LidarOdometry replayed(config, course.calibration);
   for (const Measurement& m : course.stream) replayed.process(m);
   replayed.finish();
@@ -178,6 +179,7 @@ TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   cb.sweep = [&](const ScanOutcome&) { ++processed; };
   cb.loop = [&](const LoopCorrection&) { ++corrections; };
   SystemConfig live = liveConfig(1'000'000);
+  live.odometry = config;
   live.live.loop_rate_hz = 20;  // the sweeps come ~50x faster than real time here: search about as often per sweep
   System system(live, course.calibration, cb);
   feedAsInRealTime(system, course.stream, processed);
@@ -195,6 +197,10 @@ TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   const System::KeyframeMemory memory = system.keyframeMemory();
   EXPECT_GT(memory.lis, 1'000'000u);  // [bytes] ~0.1 MB a keyframe
   EXPECT_EQ(memory.loop, 0u) << "the loop thread shares the LIS's keyframe clouds";
+  // The loop thread retires the keyframes the LIS retired (their clouds are then freed, not held by the thread).
+  EXPECT_GE(replayed.stats().keyframes_retired, 1u);
+  EXPECT_EQ(system.lis().stats().keyframes_retired, system.loopClosure()->stats().retired);
+  EXPECT_EQ(replayed.stats().keyframes_retired, replayed.loopClosure().stats().retired);
   EXPECT_GE(system.stats().loops_applied, 1u);
   // The corrections reached the LIS. Its trajectory differs from the replay's where a correction landed later
   // (the sweeps matched in between, against the uncorrected map): measured 5.0 cm at worst. Against the truth both
@@ -212,8 +218,8 @@ TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   o.alignment = eval::Alignment::kSe3;
   const double ape_replay = eval::computeApe(lidar_truth, a, o).stats.rmse;
   const double ape_live = eval::computeApe(lidar_truth, b, o).stats.rmse;
-  std::printf("overlap: %zu loops; replay vs live worst %.4f m; APE rmse replay %.4f m, live %.4f m\n", got.size(),
-              worst, ape_replay, ape_live);
+  std::printf("overlap: %zu loops; replay vs live worst %.4f m; APE rmse replay %.4f m, live %.4f m; %zu keyframes "
+              "retired\n", got.size(), worst, ape_replay, ape_live, system.lis().stats().keyframes_retired);
   EXPECT_LT(worst, 0.10);
   EXPECT_LT(ape_live, 1.1 * ape_replay + 0.005);
 }

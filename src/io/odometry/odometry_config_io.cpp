@@ -64,7 +64,9 @@ void bindLocalMap(YamlSection& s, lidar::LocalMapConfig& c) {
       .bind("edge_leaf", c.edge_leaf)
       .bind("plane_leaf", c.plane_leaf)
       .bind("full_leaf", c.full_leaf)
-      .bind("cache_capacity", c.cache_capacity);
+      .bind("cache_capacity", c.cache_capacity)
+      .bind("retire_radius", c.retire_radius)
+      .bind("retire_age", c.retire_age);
 }
 
 void bindMatcher(YamlSection& s, lidar::ScanMatcherConfig& c, EnumStrings& e) {

@@ -9,7 +9,8 @@
 //                   spin (ccw | cw), ring_source (elevation | order), order_top_down, min_range, max_range [m]
 //     features:     edge_threshold, surf_threshold (LIO-SAM edgeThreshold/surfThreshold), surf_leaf, edge_leaf,
 //                   full_leaf [m], sub_regions, max_edges_per_region, ... (lidar/feature_extractor.hpp)
-//     local_map:    surrounding_radius [m], keyframe_density [m], recent_window [s], edge_leaf, plane_leaf [m], ...
+//     local_map:    surrounding_radius [m], keyframe_density [m], recent_window [s], edge_leaf, plane_leaf [m],
+//                   retire_radius [m], retire_age [s], ... (lidar/local_map.hpp)
 //     matcher:      max_iterations, degeneracy_threshold, kernel (lio-sam | huber), ...
 //     keyframes:    distance [m], angle [rad]
 //     imu:          gyro_noise_density, acc_noise_density, gyro_bias_random_walk, acc_bias_random_walk, gravity
