@@ -14,6 +14,7 @@
 //   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay]
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -55,14 +56,26 @@ struct Lap {
   std::size_t cache = 0, descriptors = 0;  // [bytes] the local map's world-frame cache, the Scan Context database
   pipeline::LoopStats loop_stats;        // cumulative
   std::size_t graph_refusals = 0;        // verified loops the pose graph failed to solve (cumulative)
+  double graph_iterations = 0;           // mean iterations of the re-solves of this lap's accepted loops
+  double max_rotation = 0;               // [rad] largest implied rotation of this lap's accepted loops
 };
 
-// Loops the pose graph refused: verified, within the drift budget, rolled back because the solve failed.
-std::size_t graphRefusals(const pipeline::LoopClosure& loops) {
-  std::size_t n = 0;
-  for (const pipeline::LoopEvent& e : loops.events())
-    if (e.verification.reason.rfind("rejected: pose graph failed", 0) == 0) ++n;
-  return n;
+// The loop closure's counts: loops the pose graph refused (verified, within the drift budget, rolled back because
+// the solve failed), and for the events since `first_event` (this lap) the solves' mean iterations and the largest
+// rotation a loop implied.
+void loopCounts(const pipeline::LoopClosure& loops, std::size_t first_event, Lap& row) {
+  row.loop_stats = loops.stats();
+  std::size_t solves = 0, iterations = 0;
+  const std::vector<pipeline::LoopEvent>& events = loops.events();
+  for (std::size_t i = 0; i < events.size(); ++i) {
+    const pipeline::LoopEvent& e = events[i];
+    if (e.verification.reason.rfind("rejected: pose graph failed", 0) == 0) ++row.graph_refusals;
+    if (i < first_event || !e.verification.accepted) continue;
+    ++solves;
+    iterations += static_cast<std::size_t>(e.graph_iterations);
+    row.max_rotation = std::max(row.max_rotation, e.implied_rotation);
+  }
+  row.graph_iterations = solves ? static_cast<double>(iterations) / static_cast<double>(solves) : 0.0;
 }
 
 // The System (live threads) or LidarOdometry (replay, in line) fed measurement by measurement.
@@ -117,8 +130,8 @@ class LiveRunner : public Runner {
       row.retired = lis.stats().keyframes_retired;
       row.cache = lis.keyframeMap().cacheBytes();
       if (loops) {
-        row.loop_stats = loops->stats();
-        row.graph_refusals = graphRefusals(*loops);
+        loopCounts(*loops, events_seen_, row);
+        events_seen_ = loops->events().size();
         row.descriptors = loops->descriptorBytes();
       }
     });
@@ -128,7 +141,7 @@ class LiveRunner : public Runner {
  private:
   std::unique_ptr<pipeline::System> system_;
   std::atomic<std::size_t> processed_{0};
-  std::size_t pushed_ = 0;
+  std::size_t pushed_ = 0, events_seen_ = 0;
   std::mutex record_mutex_;
 };
 
@@ -152,8 +165,8 @@ class ReplayRunner : public Runner {
     row.retired = lis_.stats().keyframes_retired;
     row.cache = lis_.keyframeMap().cacheBytes();
     row.descriptors = lis_.loopClosure().descriptorBytes();
-    row.loop_stats = lis_.loopClosure().stats();
-    row.graph_refusals = graphRefusals(lis_.loopClosure());
+    loopCounts(lis_.loopClosure(), events_seen_, row);
+    events_seen_ = lis_.loopClosure().events().size();
   }
   void finish() override {
     for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
@@ -161,7 +174,7 @@ class ReplayRunner : public Runner {
 
  private:
   pipeline::LidarOdometry lis_;
-  std::size_t processed_ = 0;
+  std::size_t processed_ = 0, events_seen_ = 0;
 };
 
 }  // namespace
@@ -197,7 +210,8 @@ int main(int argc, char** argv) {
   std::vector<Lap> rows;
   const auto wall0 = std::chrono::steady_clock::now();
   std::printf("%s: lap  data_s  wall_s  sweeps  keyframes  retired  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  "
-              "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms\n",
+              "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms  iterations  "
+              "max_rot_deg\n",
               mode.c_str());
   for (int lap = 0; lap < laps; ++lap) {
     const Time offset = lap * lap_span;
@@ -222,11 +236,11 @@ int main(int argc, char** argv) {
     rows.push_back(row);
     const pipeline::LoopStats& ls = row.loop_stats;
     std::printf("%3d  %6.0f  %6.0f  %6zu  %9zu  %7zu  %5zu  %7zu  %6.1f  %7.1f  %9.1f  %10.1f  %8.1f  %5.1f  | %8zu  "
-                "%8zu  %11zu  %13zu  %8.0f\n",
+                "%8zu  %11zu  %13zu  %8.0f  %10.1f  %11.1f\n",
                 row.lap, row.data_s, row.wall_s, row.sweeps, row.keyframes, row.retired, row.loops, row.dropped,
                 row.rss_kb / 1024.0, row.peak_kb / 1024.0, row.kf_lis / 1048576.0, row.kf_loop / 1048576.0,
                 row.cache / 1048576.0, row.descriptors / 1048576.0, ls.verified, ls.accepted, ls.over_drift_budget,
-                row.graph_refusals, ls.graph_ms);
+                row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / 3.141592653589793);
     std::fflush(stdout);
   }
   runner->finish();

@@ -56,11 +56,14 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
          {"inlier_ratio", v.inlier_ratio},
          {"correction_from_guess_m", v.correction_translation},
          {"graph_ms", e.graph_ms},
+         {"graph_iterations", e.graph_iterations},
          {"graph_initial_cost", e.graph_initial_cost},
          {"graph_final_cost", e.graph_final_cost},
          {"trajectory_correction_m", e.correction},
          {"implied_drift_m", e.implied_drift},
-         {"drift_budget_m", e.drift_budget}};
+         {"drift_budget_m", e.drift_budget},
+         {"implied_rotation_deg", e.implied_rotation * kDeg},
+         {"rotation_budget_deg", e.rotation_budget * kDeg}};
   correct = false;
   const auto a = truth.lidarAt(e.t_candidate), b = truth.lidarAt(e.t_query);
   if (a && b) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 
@@ -43,13 +44,15 @@ std::string LoopClosureConfig::validate() const {
   if (std::string e = verifier.validate(); !e.empty()) return "verifier: " + e;
   if (std::string e = graph.validate(); !e.empty()) return "graph: " + e;
   const double positive[] = {radius, odometry_sigma_position, odometry_sigma_rotation, degenerate_sigma,
-                             max_drift_floor};
+                             max_drift_floor, max_rotation_drift_floor};
   for (double v : positive)
     if (!std::isfinite(v) || v <= 0)
-      return "radius, odometry_sigma_*, degenerate_sigma and max_drift_floor must be finite and > 0";
-  if (!std::isfinite(max_drift_ratio) || max_drift_ratio < 0 || !std::isfinite(degenerate_drift) ||
-      degenerate_drift < 0)
-    return "max_drift_ratio and degenerate_drift must be finite and >= 0";
+      return "radius, odometry_sigma_*, degenerate_sigma, max_drift_floor and max_rotation_drift_floor must be finite "
+             "and > 0";
+  for (double v : {max_drift_ratio, degenerate_drift, max_rotation_drift_ratio, degenerate_rotation_drift})
+    if (!std::isfinite(v) || v < 0)
+      return "max_drift_ratio, degenerate_drift, max_rotation_drift_ratio and degenerate_rotation_drift must be "
+             "finite and >= 0";
   if (!std::isfinite(min_age) || min_age < 0) return "min_age must be finite and >= 0 s";
   if (submap_keyframes < 0 || max_verifications < 1 || skip_after_loop < 0)
     return "submap_keyframes and skip_after_loop must be >= 0, max_verifications >= 1";
@@ -244,6 +247,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
     e.graph_initial_cost = r.initial_cost;
     e.graph_final_cost = r.final_cost;
     e.graph_ms = r.time_ms;
+    e.graph_iterations = r.iterations;
     stats.graph_ms += r.time_ms;
     if (!r.usable) {
       graph.setEdgeEnabled(edge, false);
@@ -258,23 +262,34 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
   return e.verification.accepted;
 }
 
-// Rejects a verified loop that would move the query further than the odometry can have drifted (see the config).
+// Rejects a verified loop that would move or turn the query further than the odometry can have drifted (see the
+// config).
 void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& e) {
   double path = 0;
   for (std::size_t i = e.candidate + 1; i <= e.query; ++i)
     path += (map.keyframe(i).T_world_lidar.translation() - map.keyframe(i - 1).T_world_lidar.translation()).norm();
   const Eigen::Isometry3d T_est =
       map.keyframe(e.candidate).T_world_lidar.inverse() * map.keyframe(e.query).T_world_lidar;
+  const double degenerate = degenerate_before[e.query] - degenerate_before[e.candidate];
   e.implied_drift = (e.verification.T_candidate_query.translation() - T_est.translation()).norm();
-  e.drift_budget = config.max_drift_floor + config.max_drift_ratio * path +
-                   config.degenerate_drift * (degenerate_before[e.query] - degenerate_before[e.candidate]);
-  if (e.implied_drift <= e.drift_budget) return;
+  e.drift_budget = config.max_drift_floor + config.max_drift_ratio * path + config.degenerate_drift * degenerate;
+  e.implied_rotation = geometry::rotationAngle(T_est.linear().transpose() * e.verification.T_candidate_query.linear());
+  e.rotation_budget = config.max_rotation_drift_floor + config.max_rotation_drift_ratio * path +
+                      config.degenerate_rotation_drift * degenerate;
+  if (e.implied_drift <= e.drift_budget && e.implied_rotation <= e.rotation_budget) return;
   ++stats.over_drift_budget;
   e.verification.accepted = false;
-  e.verification.reason = fmt::format(
-      "rejected: the loop moves the query {:.2f} m from the estimate, more than the "
-      "drift budget {:.2f} m over {:.1f} m of path ({})",
-      e.implied_drift, e.drift_budget, path, e.verification.reason);
+  if (e.implied_drift > e.drift_budget) {
+    e.verification.reason = fmt::format(
+        "rejected: the loop moves the query {:.2f} m from the estimate, more than the "
+        "drift budget {:.2f} m over {:.1f} m of path ({})",
+        e.implied_drift, e.drift_budget, path, e.verification.reason);
+  } else {
+    e.verification.reason = fmt::format(
+        "rejected: the loop turns the query {:.1f} deg from the estimate, more than the "
+        "rotation budget {:.1f} deg over {:.1f} m of path ({})",
+        e.implied_rotation * 180 / std::numbers::pi, e.rotation_budget * 180 / std::numbers::pi, path, e.verification.reason);
+  }
 }
 
 void LoopClosure::setVisualYawPrior(VisualYawPrior prior) { impl_->visual_prior = std::move(prior); }

@@ -49,6 +49,14 @@ struct LoopClosureConfig {
   double max_drift_floor = 2.0;   // [m]
   double max_drift_ratio = 0.15;  // [-] of the path length
   double degenerate_drift = 0.5;  // [m] per degenerate direction of a sweep
+  // The same for the relative rotation: the loop may turn the query (relative to the candidate) by at most
+  // max_rotation_drift_floor + max_rotation_drift_ratio * path + degenerate_rotation_drift per degenerate direction.
+  // A lidar-inertial odometry's heading drifts well under 1 deg per 100 m; a loop from a Scan Context shift half a
+  // turn off (a symmetric barn fits as well turned round) would tell the graph to turn the robot round, a rotation
+  // residual near pi where the log map is discontinuous, and such loops can break the graph's later solves.
+  double max_rotation_drift_floor = 0.2;      // [rad] (11 deg)
+  double max_rotation_drift_ratio = 0.0005;   // [rad/m] (2.9 deg per 100 m)
+  double degenerate_rotation_drift = 0.05;    // [rad] per degenerate direction of a sweep
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };
@@ -65,8 +73,10 @@ struct LoopEvent {
   int full_shift = -1;  // the full search's shift on the same descriptors (to compare; -1: radius)
   loop::LoopVerification verification;
   double graph_initial_cost = 0, graph_final_cost = 0, graph_ms = 0;  // of the re-solve (accepted only)
+  int graph_iterations = 0;                                            // of the re-solve (accepted only)
   double correction = 0;                       // [m] how far the re-solve moved the query keyframe
   double implied_drift = 0, drift_budget = 0;  // [m] |loop - estimate| of the relative translation, and its limit
+  double implied_rotation = 0, rotation_budget = 0;  // [rad] angle of loop vs estimate relative rotation, limit
 };
 
 struct LoopStats {

@@ -396,6 +396,9 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   source: both
   min_age: 12.5
   max_drift_ratio: 0.2
+  max_rotation_drift_floor: 0.3
+  max_rotation_drift_ratio: 0.001
+  degenerate_rotation_drift: 0.02
   scan_context:
     sensor_height: 1.5
     auto_height: true
@@ -417,6 +420,9 @@ odometry:
   EXPECT_EQ(c.loop.source, pipeline::LoopSource::kBoth);
   EXPECT_EQ(c.loop.min_age, 12.5);
   EXPECT_EQ(c.loop.max_drift_ratio, 0.2);
+  EXPECT_EQ(c.loop.max_rotation_drift_floor, 0.3);
+  EXPECT_EQ(c.loop.max_rotation_drift_ratio, 0.001);
+  EXPECT_EQ(c.loop.degenerate_rotation_drift, 0.02);
   EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
   EXPECT_TRUE(c.loop.database.descriptor.auto_height);
   EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);

@@ -38,7 +38,11 @@ Eigen::Isometry3d lapPose(int i) {
 TEST(LoopClosure, PullsADriftingLapBackOntoTheTruthWhenItReturnsToItsStart) {
   const lidar::FeatureSet world = test::courtyard(0);
   lidar::LocalMap map;
-  LoopClosure loops(courtyardConfig());
+  LoopClosureConfig config = courtyardConfig();
+  // This odometry turns 24 deg too far in 28 m, far more than a lidar-inertial odometry does (the default rotation
+  // budget, 11 deg + 2.9 deg per 100 m, would refuse the loop as one that cannot be true): opened for it here.
+  config.max_rotation_drift_floor = 0.6;  // [rad]
+  LoopClosure loops(config);
   // Odometry with a 0.6 deg yaw error and 4 % scale error per step: after 40 steps the last pose is off by
   // 24 deg and more than a metre.
   Eigen::Isometry3d T_est = lapPose(0);
@@ -104,6 +108,46 @@ TEST(LoopClosure, ATwinPlaceThirtyMetresAwayFitsPerfectlyButIsRejectedByTheDrift
     twins += std::abs(e.implied_drift - 30.0) < 0.5 && e.verification.reason.find("drift budget") != std::string::npos;
   }
   EXPECT_GE(twins, 5);
+}
+
+// The lap with exact positions but, from keyframe 20 on, every heading 30 deg off (as after a bad turn): the loops
+// back to the start are true, with the true relative pose, and say the query must turn 30 deg, while its position
+// is right. The default rotation budget (11 deg + 2.9 deg per 100 m of the ~28 m between them) refuses them; a
+// looser one accepts them.
+std::unique_ptr<LoopClosure> lapWithAHeadingError(const LoopClosureConfig& c) {
+  auto loops = std::make_unique<LoopClosure>(c);
+  lidar::LocalMap map;
+  for (int i = 0; i <= 40; ++i) {
+    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
+    f.t = fromSeconds(i);
+    const Eigen::Isometry3d T_est = i < 20 ? lapPose(i) : lapPose(i) * test::planarPose(0, 0, 30.0);
+    if (loops->addKeyframe(map, map.addKeyframe(f, T_est), geometry::Matrix6d::Zero())) {
+      const std::vector<Eigen::Isometry3d> poses = loops->poses();
+      for (std::size_t k = 0; k < poses.size(); ++k) map.updatePose(k, poses[k]);
+    }
+  }
+  return loops;
+}
+
+TEST(LoopClosure, ALoopThatWouldTurnTheQueryBeyondTheRotationBudgetIsRejectedAndALooserBudgetAcceptsIt) {
+  const auto strict = lapWithAHeadingError(courtyardConfig());
+  EXPECT_EQ(strict->stats().accepted, 0u);
+  int turned = 0;
+  for (const LoopEvent& e : strict->events()) {
+    if (e.verification.reason.find("rotation budget") == std::string::npos) continue;
+    ++turned;
+    EXPECT_NEAR(e.implied_rotation * 180 / kPi, 30.0, 2.0);
+    EXPECT_LT(e.implied_drift, 0.3) << "the position was right";
+    EXPECT_NEAR(e.rotation_budget, 0.2 + 0.0005 * 4 * 2 * kPi * (e.query - e.candidate) / 36.0, 0.01);
+  }
+  EXPECT_GE(turned, 1);
+  LoopClosureConfig loose = courtyardConfig();
+  loose.max_rotation_drift_floor = 0.7;  // [rad] 40 deg
+  const auto accepted = lapWithAHeadingError(loose);
+  ASSERT_GE(accepted->stats().accepted, 1u);
+  const auto first = std::find_if(accepted->events().begin(), accepted->events().end(),
+                                  [](const LoopEvent& e) { return e.verification.accepted; });
+  EXPECT_NEAR(first->implied_rotation * 180 / kPi, 30.0, 2.0);
 }
 
 // Runs the exact (drift-free) lap with the given config and optional visual prior; returns the loop closure.
@@ -176,7 +220,14 @@ TEST(LoopClosure, RejectsInvalidConfigsAndOutOfOrderKeyframes) {
   c = {};
   c.radius = -1;
   EXPECT_THROW(LoopClosure{c}, std::invalid_argument);
+  c = {};
+  c.max_rotation_drift_ratio = -0.001;
+  EXPECT_NE(c.validate().find("max_rotation_drift_ratio"), std::string::npos);
+  c = {};
+  c.max_rotation_drift_floor = 0;
+  EXPECT_NE(c.validate().find("max_rotation_drift_floor"), std::string::npos);
   LoopClosure loops{LoopClosureConfig{}};
+  EXPECT_THROW(loops.retire(0), std::invalid_argument);
   lidar::LocalMap map;
   map.addKeyframe(test::courtyard(0), Eigen::Isometry3d::Identity());
   map.addKeyframe(test::courtyard(0), Eigen::Isometry3d::Identity());

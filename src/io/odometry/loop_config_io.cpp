@@ -21,6 +21,9 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("max_drift_floor", c.max_drift_floor)
       .bind("max_drift_ratio", c.max_drift_ratio)
       .bind("degenerate_drift", c.degenerate_drift)
+      .bind("max_rotation_drift_floor", c.max_rotation_drift_floor)
+      .bind("max_rotation_drift_ratio", c.max_rotation_drift_ratio)
+      .bind("degenerate_rotation_drift", c.degenerate_rotation_drift)
       .nested("scan_context",
               [&](YamlSection& n) {
                 n.bind("rings", d.rings)

@@ -3,7 +3,8 @@
 // optional (left out = the defaults in pipeline/loop_closure.hpp and loop/*.hpp, which give the units):
 //   loop: enabled, source (scancontext | radius | both), yaw_prior, min_age [s], submap_keyframes,
 //         max_verifications, skip_after_loop, radius [m], odometry_sigma_position [m], odometry_sigma_rotation [rad],
-//         degenerate_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m]
+//         degenerate_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m],
+//         max_rotation_drift_floor [rad], max_rotation_drift_ratio [rad/m], degenerate_rotation_drift [rad]
 //     scan_context: rings, sectors, max_radius [m], sensor_height [m], auto_height, ground_lift [m], threshold,
 //                   search_radius [sectors],
 //                   lateral_step [m], lateral_steps, candidates, exclude_recent [keyframes]
