@@ -298,6 +298,8 @@ void LoopClosure::retire(std::size_t index) {
   if (index >= impl_->times.size())
     throw std::invalid_argument(fmt::format("loop closure: cannot retire keyframe {} of {}", index, impl_->times.size()));
   if (impl_->config.enabled) impl_->database.remove(static_cast<int>(index));
+  // Its graph node stays free: held fixed, a first pass could no longer follow the loops a later pass closes (on
+  // kitti05-replay the APE went from 0.42 to 0.71 m).
   ++impl_->stats.retired;
 }
 

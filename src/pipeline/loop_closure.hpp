@@ -111,8 +111,9 @@ class LoopClosure {
   // The shift search's prior comes from `prior` when it returns one, else from the current estimate (when
   // config.yaw_prior). An empty function removes it. The VIS fills this in later; until then only the estimate.
   void setVisualYawPrior(VisualYawPrior prior);
-  // Keyframe `index` was retired from the map (LocalMap::retire): its Scan Context leaves the database, and it is
-  // no longer a radius candidate (its graph node stays). Call after retiring it in the map given to addKeyframe.
+  // Keyframe `index` was retired from the map (LocalMap::retire): its Scan Context leaves the database and it is no
+  // longer a radius candidate (its graph node and edges stay). Call after retiring it in the map given to
+  // addKeyframe.
   void retire(std::size_t index);
   std::size_t descriptorBytes() const;  // [bytes] the database's stored descriptors
 
