@@ -67,6 +67,7 @@ struct LoopClosure::Impl {
   std::vector<Time> times;
   std::vector<bool> searched;             // by keyframe
   std::vector<double> degenerate_before;  // by keyframe: degenerate directions reported up to it (cumulative)
+  std::vector<double> degenerate_rotation_before;  // the same, their rotational share only (|phi|^2 of each)
   std::vector<LoopEvent> events;
   LoopStats stats;
   VisualYawPrior visual_prior;
@@ -116,6 +117,9 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   m.searched.push_back(false);
   m.degenerate_before.push_back((m.degenerate_before.empty() ? 0.0 : m.degenerate_before.back()) +
                                 degenerate_cov.trace());
+  m.degenerate_rotation_before.push_back(
+      (m.degenerate_rotation_before.empty() ? 0.0 : m.degenerate_rotation_before.back()) +
+      degenerate_cov.bottomRightCorner<3, 3>().trace());
   m.graph.addNode(static_cast<int>(index), kf.T_world_lidar);
   if (index > 0) m.addOdometryEdge(map, index, degenerate_cov);
   if (!m.config.enabled) return false;
@@ -274,8 +278,11 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
   e.implied_drift = (e.verification.T_candidate_query.translation() - T_est.translation()).norm();
   e.drift_budget = config.max_drift_floor + config.max_drift_ratio * path + config.degenerate_drift * degenerate;
   e.implied_rotation = geometry::rotationAngle(T_est.linear().transpose() * e.verification.T_candidate_query.linear());
-  e.rotation_budget = config.max_rotation_drift_floor + config.max_rotation_drift_ratio * path +
-                      config.degenerate_rotation_drift * degenerate;
+  // Only the rotational share of the degenerate directions loosens it: a corridor's degenerate translation says
+  // nothing about the heading.
+  e.rotation_budget =
+      config.max_rotation_drift_floor + config.max_rotation_drift_ratio * path +
+      config.degenerate_rotation_drift * (degenerate_rotation_before[e.query] - degenerate_rotation_before[e.candidate]);
   if (e.implied_drift <= e.drift_budget && e.implied_rotation <= e.rotation_budget) return;
   ++stats.over_drift_budget;
   e.verification.accepted = false;

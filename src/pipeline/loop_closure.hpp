@@ -50,7 +50,8 @@ struct LoopClosureConfig {
   double max_drift_ratio = 0.15;  // [-] of the path length
   double degenerate_drift = 0.5;  // [m] per degenerate direction of a sweep
   // The same for the relative rotation: the loop may turn the query (relative to the candidate) by at most
-  // max_rotation_drift_floor + max_rotation_drift_ratio * path + degenerate_rotation_drift per degenerate direction.
+  // max_rotation_drift_floor + max_rotation_drift_ratio * path + degenerate_rotation_drift per degenerate direction
+  // (counted by its rotational share: |phi|^2 of the unit direction [rho; phi]).
   // A lidar-inertial odometry's heading drifts well under 1 deg per 100 m; a loop from a Scan Context shift half a
   // turn off (a symmetric barn fits as well turned round) would tell the graph to turn the robot round, a rotation
   // residual near pi where the log map is discontinuous, and such loops can break the graph's later solves.

@@ -114,14 +114,15 @@ TEST(LoopClosure, ATwinPlaceThirtyMetresAwayFitsPerfectlyButIsRejectedByTheDrift
 // back to the start are true, with the true relative pose, and say the query must turn 30 deg, while its position
 // is right. The default rotation budget (11 deg + 2.9 deg per 100 m of the ~28 m between them) refuses them; a
 // looser one accepts them.
-std::unique_ptr<LoopClosure> lapWithAHeadingError(const LoopClosureConfig& c) {
+std::unique_ptr<LoopClosure> lapWithAHeadingError(const LoopClosureConfig& c,
+                                                  const geometry::Matrix6d& degenerate = geometry::Matrix6d::Zero()) {
   auto loops = std::make_unique<LoopClosure>(c);
   lidar::LocalMap map;
   for (int i = 0; i <= 40; ++i) {
     lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
     f.t = fromSeconds(i);
     const Eigen::Isometry3d T_est = i < 20 ? lapPose(i) : lapPose(i) * test::planarPose(0, 0, 30.0);
-    if (loops->addKeyframe(map, map.addKeyframe(f, T_est), geometry::Matrix6d::Zero())) {
+    if (loops->addKeyframe(map, map.addKeyframe(f, T_est), degenerate)) {
       const std::vector<Eigen::Isometry3d> poses = loops->poses();
       for (std::size_t k = 0; k < poses.size(); ++k) map.updatePose(k, poses[k]);
     }
@@ -141,6 +142,20 @@ TEST(LoopClosure, ALoopThatWouldTurnTheQueryBeyondTheRotationBudgetIsRejectedAnd
     EXPECT_NEAR(e.rotation_budget, 0.2 + 0.0005 * 4 * 2 * kPi * (e.query - e.candidate) / 36.0, 0.01);
   }
   EXPECT_GE(turned, 1);
+  // Every step degenerate along x (a corridor): the translation budget opens by 0.5 m a step, the rotation budget
+  // not at all (a degenerate translation says nothing about the heading), and the loops are still refused.
+  geometry::Matrix6d along_x = geometry::Matrix6d::Zero();
+  along_x(0, 0) = 1.0;
+  const auto corridor = lapWithAHeadingError(courtyardConfig(), along_x);
+  EXPECT_EQ(corridor->stats().accepted, 0u);
+  int in_corridor = 0;
+  for (const LoopEvent& e : corridor->events()) {
+    if (e.verification.reason.find("rotation budget") == std::string::npos) continue;
+    ++in_corridor;
+    EXPECT_GT(e.drift_budget, 2.0 + 0.5 * static_cast<double>(e.query - e.candidate) - 0.01);
+    EXPECT_NEAR(e.rotation_budget, 0.2 + 0.0005 * 4 * 2 * kPi * (e.query - e.candidate) / 36.0, 0.01);
+  }
+  EXPECT_GE(in_corridor, 1);
   LoopClosureConfig loose = courtyardConfig();
   loose.max_rotation_drift_floor = 0.7;  // [rad] 40 deg
   const auto accepted = lapWithAHeadingError(loose);
