@@ -14,11 +14,22 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
   const Eigen::Isometry3d T_world_lidar =
       kf.index == 0 ? kf.T_world_lidar : map_.keyframe(kf.index - 1).T_world_lidar * kf.T_previous_this;
   map_.addSharedKeyframe(kf.features, T_world_lidar);  // the LIS's own clouds, not a copy
-  std::optional<LoopCorrection> c = search(kf);
-  for (std::size_t i : kf.retired) {  // after the search, as the in-line loop closure does
-    map_.retire(i);
-    loops_.retire(i);
+  // After the search, as the in-line loop closure does, and also when the search throws (the System goes on with
+  // the next keyframe): the retired clouds are not kept here.
+  const auto retire = [&] {
+    for (std::size_t i : kf.retired) {
+      map_.retire(i);
+      loops_.retire(i);
+    }
+  };
+  std::optional<LoopCorrection> c;
+  try {
+    c = search(kf);
+  } catch (...) {
+    retire();
+    throw;
   }
+  retire();
   return c;
 }
 
