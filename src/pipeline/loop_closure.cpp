@@ -295,7 +295,8 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
     e.verification.reason = fmt::format(
         "rejected: the loop turns the query {:.1f} deg from the estimate, more than the "
         "rotation budget {:.1f} deg over {:.1f} m of path ({})",
-        e.implied_rotation * 180 / std::numbers::pi, e.rotation_budget * 180 / std::numbers::pi, path, e.verification.reason);
+        e.implied_rotation * 180 / std::numbers::pi, e.rotation_budget * 180 / std::numbers::pi, path,
+        e.verification.reason);
   }
 }
 
