@@ -23,6 +23,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <numbers>
 #include <string>
 #include <thread>
 
@@ -244,7 +245,7 @@ int main(int argc, char** argv) {
                 row.lap, row.data_s, row.wall_s, row.sweeps, row.keyframes, row.retired, row.loops, row.dropped,
                 row.rss_kb / 1024.0, row.peak_kb / 1024.0, row.kf_lis / 1048576.0, row.kf_loop / 1048576.0,
                 row.cache / 1048576.0, row.descriptors / 1048576.0, ls.verified, ls.accepted, ls.over_drift_budget,
-                row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / 3.141592653589793);
+                row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / std::numbers::pi);
     std::fflush(stdout);
   }
   runner->finish();
