@@ -13,7 +13,12 @@
 // by the drift budget, refused by the pose graph) to follow the loop closure over hours.
 // LOOP_HZ (live) is the loop thread's rate [Hz of wall time]; the System is fed faster than real time here, so a
 // rate of the feeding speed-up (~5) makes corrections land as late in data time as 1 Hz on a robot.
-//   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay] [LOOP_HZ=1]
+// MODE delayed is the live loop thread made deterministic: the LIS hands its keyframes out as in the System, a
+// LoopWorker searches them in a batch every 1 / LOOP_HZ seconds of *data* time, and the newest correction is applied
+// before the next sweep, as late as the loop thread would make it, reproducibly.
+// The ground truth of every lap (10 Hz, T_world_imu) goes to OUT_DIR/bench_memory_truth.tum, for drover eval ape
+// against bench_memory_imu_rate.tum.
+//   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay|delayed] [LOOP_HZ=1]
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -29,6 +34,8 @@
 
 #include "apps/drover/run_record.hpp"
 #include "io/odometry/odometry_config_io.hpp"
+#include "io/trajectory_io.hpp"
+#include "pipeline/loop_worker.hpp"
 #include "pipeline/system.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
@@ -81,6 +88,19 @@ void loopCounts(const pipeline::LoopClosure& loops, std::size_t first_event, Lap
   row.graph_iterations = solves ? static_cast<double>(iterations) / static_cast<double>(solves) : 0.0;
 }
 
+// Every verified loop (replay and delayed modes), one line each, to follow the loop closure lap by lap.
+void writeLoopEvents(const pipeline::LoopClosure& loops, const std::string& path) {
+  std::ofstream out(path);
+  out << "t_query_s,query,candidate,source,accepted,implied_drift_m,drift_budget_m,implied_rotation_deg,"
+         "rotation_budget_deg,correction_m,graph_iterations,reason\n";
+  for (const pipeline::LoopEvent& e : loops.events())
+    out << fmt::format("{:.2f},{},{},{},{},{:.3f},{:.3f},{:.2f},{:.2f},{:.3f},{},\"{}\"\n", toSeconds(e.t_query),
+                       e.query, e.candidate, e.source, e.verification.accepted ? 1 : 0, e.implied_drift,
+                       e.drift_budget, e.implied_rotation * 180 / std::numbers::pi,
+                       e.rotation_budget * 180 / std::numbers::pi, e.correction, e.graph_iterations,
+                       e.verification.reason);
+}
+
 // The System (live threads) or LidarOdometry (replay, in line) fed measurement by measurement.
 class Runner {
  public:
@@ -88,6 +108,7 @@ class Runner {
   virtual void push(Measurement&& m) = 0;
   virtual void fill(Lap& row) = 0;  // counts and memory so far
   virtual void finish() = 0;
+  virtual const pipeline::LoopClosure* loops() const { return nullptr; }
   cli::RunRecord record;
 };
 
@@ -175,9 +196,63 @@ class ReplayRunner : public Runner {
   void finish() override {
     for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
   }
+  const pipeline::LoopClosure* loops() const override { return &lis_.loopClosure(); }
 
  private:
   pipeline::LidarOdometry lis_;
+  std::size_t processed_ = 0, events_seen_ = 0;
+};
+
+// LidarOdometry with its loop closure outside, in line: keyframes searched by a LoopWorker in batches every
+// `period` of data time, corrections applied before the next sweep.
+class DelayedRunner : public Runner {
+ public:
+  DelayedRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration, double period_s)
+      : lis_(odometry, calibration), worker_(odometry.loop, odometry.local_map), period_(fromSeconds(period_s)) {
+    lis_.setImuRateListener([this](const StampedPose& p) { record.imu_rate->add(p.t, p.T_world_body); });
+    lis_.setKeyframeListener([this](const pipeline::KeyframeRecord& k) { pending_.push_back(k); }, true);
+  }
+  void push(Measurement&& m) override {
+    if (const auto* scan = std::get_if<LidarScan>(&m)) {
+      if (scan->t >= next_batch_) {
+        next_batch_ = scan->t + period_;
+        for (const pipeline::KeyframeRecord& k : pending_)
+          if (std::optional<pipeline::LoopCorrection> c = worker_.add(k)) correction_ = std::move(c);
+        pending_.clear();
+      }
+      if (correction_) {
+        lis_.applyLoopCorrection(*correction_);
+        correction_.reset();
+      }
+    }
+    for (const pipeline::ScanOutcome& s : lis_.process(m)) {
+      record.add(s);
+      ++processed_;
+    }
+  }
+  void fill(Lap& row) override {
+    row.sweeps = processed_;
+    row.loops = lis_.stats().loop_times.size();
+    row.keyframes = lis_.stats().keyframes;
+    row.kf_lis = lis_.keyframeBytes();
+    row.kf_loop = worker_.keyframeBytes();
+    row.retired = lis_.stats().keyframes_retired;
+    row.cache = lis_.keyframeMap().cacheBytes();
+    row.descriptors = worker_.loopClosure().descriptorBytes();
+    loopCounts(worker_.loopClosure(), events_seen_, row);
+    events_seen_ = worker_.loopClosure().events().size();
+  }
+  void finish() override {
+    for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
+  }
+  const pipeline::LoopClosure* loops() const override { return &worker_.loopClosure(); }
+
+ private:
+  pipeline::LidarOdometry lis_;
+  pipeline::LoopWorker worker_;
+  Time period_ = 0, next_batch_ = 0;
+  std::vector<pipeline::KeyframeRecord> pending_;
+  std::optional<pipeline::LoopCorrection> correction_;
   std::size_t processed_ = 0, events_seen_ = 0;
 };
 
@@ -189,8 +264,8 @@ int main(int argc, char** argv) {
   const std::string out_dir = argc > 3 ? argv[3] : "/tmp";
   const std::string mode = argc > 4 ? argv[4] : "live";
   const double loop_hz = argc > 5 ? std::stod(argv[5]) : 1.0;
-  if (mode != "live" && mode != "replay") {
-    std::fprintf(stderr, "MODE must be live or replay, not '%s'\n", mode.c_str());
+  if (mode != "live" && mode != "replay" && mode != "delayed") {
+    std::fprintf(stderr, "MODE must be live, replay or delayed, not '%s'\n", mode.c_str());
     return 2;
   }
   sim::ScenarioOptions so;
@@ -205,9 +280,12 @@ int main(int argc, char** argv) {
   std::unique_ptr<Runner> runner;
   if (mode == "live") {
     runner = std::make_unique<LiveRunner>(farmConfig(), calibration, loop_hz);
+  } else if (mode == "delayed") {
+    runner = std::make_unique<DelayedRunner>(farmConfig(), calibration, 1.0 / loop_hz);
   } else {
     runner = std::make_unique<ReplayRunner>(farmConfig(), calibration);
   }
+  Trajectory truth;
   runner->record.log.streamTo(out_dir + "/bench_memory_sweeps.jsonl");
   runner->record.imu_rate =
       std::make_shared<cli::ImuRateFile>(out_dir + "/bench_memory_imu_rate.tum", Eigen::Isometry3d::Identity());
@@ -222,6 +300,8 @@ int main(int argc, char** argv) {
     const Time offset = lap * lap_span;
     // Each lap its own noise (seed + lap); the same world and path: the robot drives the same course again.
     const sim::Simulator simulator(scenario, sc, seed + static_cast<unsigned>(lap) * 1000);
+    const Trajectory lap_truth = simulator.groundTruth();
+    for (std::size_t i = 0; i < lap_truth.size(); i += 20) truth.push_back({lap_truth[i].t + offset, lap_truth[i].T_world_body});
     simulator.run([&](Measurement&& m) {
       if (auto* imu = std::get_if<ImuSample>(&m)) {
         imu->t += offset;
@@ -249,6 +329,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
   }
   runner->finish();
+  io::writeTum(out_dir + "/bench_memory_truth.tum", truth);
+  if (const pipeline::LoopClosure* loops = runner->loops()) writeLoopEvents(*loops, out_dir + "/bench_memory_loops.csv");
   const Lap& first = rows.front();
   const Lap& last = rows.back();
   const auto mb = [](double kb) { return kb / 1024.0; };

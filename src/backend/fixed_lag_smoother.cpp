@@ -2,6 +2,8 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -99,6 +101,38 @@ void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias
       Eigen::Vector3d::Constant(1 / c.prior_sigma_gyro_bias), Eigen::Vector3d::Constant(1 / c.prior_sigma_acc_bias);
   w.prior = {w.nodes.back().statePoint(), inv_sigma.asDiagonal(), Vector15d::Zero()};
   impl_->initialized = true;
+}
+
+void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias& bias,
+                                  const imu::PreintegrationConfig& imu, const Eigen::Matrix3d& gyro_bias_covariance) {
+  const Eigen::Matrix3d& C = gyro_bias_covariance;
+  const Eigen::LLT<Eigen::Matrix3d> information((0.5 * (C + C.transpose())).inverse());
+  if (!C.allFinite() || (C - C.transpose()).norm() > 1e-9 * C.norm() || information.info() != Eigen::Success ||
+      !information.matrixU().toDenseMatrix().allFinite())
+    throw std::invalid_argument("FixedLagSmoother::initialize: the gyro bias covariance is not finite, symmetric "
+                                "and positive definite");
+  initialize(state, bias, imu);
+  Matrix15d& L = impl_->window.prior.sqrt_information;  // r = L dx: the gyro bias rows are 9..11
+  L.block<3, 3>(9, 9) = information.matrixU();
+}
+
+std::optional<Eigen::Matrix3d> FixedLagSmoother::gyroBiasCovariance() const {
+  if (!impl_->initialized) return std::nullopt;
+  SmootherWindow window = impl_->window;  // the problem points into the nodes: a copy keeps this const
+  RightQuaternionManifold manifold;
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  window.buildProblem(problem, &manifold);
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;  // ~160 parameters: cheap, and robust to a weak direction
+  ceres::Covariance covariance(options);
+  const double* b = window.nodes.back().b.data();
+  const std::vector<std::pair<const double*, const double*>> blocks = {{b, b}};
+  if (!covariance.Compute(blocks, &problem)) return std::nullopt;
+  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
+  if (!covariance.GetCovarianceBlock(b, b, C.data()) || !C.allFinite()) return std::nullopt;
+  return Eigen::Matrix3d(C.topLeftCorner<3, 3>());
 }
 
 SmootherUpdate FixedLagSmoother::update(const imu::Preintegrator& pim, const Eigen::Isometry3d& T_world_imu_measured) {

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "imu/preintegration.hpp"
@@ -63,6 +64,15 @@ class FixedLagSmoother {
   // Starts a window with one state under the config's prior. Throws std::invalid_argument for a non-finite
   // state/bias or an invalid IMU config (whose bias random walks and gravity the smoother uses).
   void initialize(const imu::NavState& state, const imu::ImuBias& bias, const imu::PreintegrationConfig& imu);
+  // The same, with the gyro bias prior's covariance [(rad/s)^2] given instead of the config's sigma: a restart
+  // that keeps what an earlier window knew of the gyro bias (gyroBiasCovariance()). Throws std::invalid_argument
+  // also when the covariance is not finite, symmetric and positive definite.
+  void initialize(const imu::NavState& state, const imu::ImuBias& bias, const imu::PreintegrationConfig& imu,
+                  const Eigen::Matrix3d& gyro_bias_covariance);
+  // The newest state's gyro bias marginal covariance [(rad/s)^2] given everything in the window (Ceres'
+  // covariance of the window's problem at the current estimate). Nothing when not initialized or when the
+  // covariance cannot be computed.
+  std::optional<Eigen::Matrix3d> gyroBiasCovariance() const;
 
   // Adds state j at t_j = state().t + fromSeconds(pim.deltaTime()) (the time predict() gives), linked to the
   // newest state by the IMU factor of `pim` (integrated from state().t, at any linearisation bias) and the bias

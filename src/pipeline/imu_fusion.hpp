@@ -53,9 +53,9 @@ class ImuFusion {
   // scan matching lets tilt drift (LIO-SAM blends the IMU's roll/pitch into the mapping pose for the same reason).
   void update(ScanOutcome& out, const Trajectory& trajectory);
 
-  // Moves the smoother and the propagation into a corrected world frame after a loop closure: the newest state
-  // becomes T_new_old * T_world_imu with its velocity rotated, biases kept (LIO-SAM re-initialises its IMU graph
-  // on the corrected odometry in the same way).
+  // Moves the smoother and the propagation into a corrected world frame after a loop closure: the smoother
+  // restarts at T_new_old * T_world_imu with its velocity rotated and its biases kept (as LIO-SAM re-initialises
+  // its IMU graph on the corrected odometry), and the gyro bias keeps the certainty the old window had of it.
   void reanchor(const Eigen::Isometry3d& T_new_old);
 
   imu::ImuStreamStats imuStats() const { return propagator_.stats(); }

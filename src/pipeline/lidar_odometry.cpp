@@ -38,7 +38,17 @@ std::vector<ScanOutcome> LidarOdometry::process(const Measurement& m) {
 
 std::vector<ScanOutcome> LidarOdometry::finish() { return impl_->drain(true); }
 
-const Trajectory& LidarOdometry::trajectory() const { return impl_->trajectory; }
+Trajectory LidarOdometry::trajectory() const {
+  Trajectory out;
+  out.reserve(impl_->anchors.size());
+  for (const Impl::Anchor& a : impl_->anchors) {
+    Eigen::Isometry3d T_kf_sweep = Eigen::Isometry3d::Identity();
+    T_kf_sweep.linear() = a.q_kf_sweep.toRotationMatrix();
+    T_kf_sweep.translation() = a.p_kf_sweep;
+    out.push_back({a.t, impl_->map.keyframe(a.keyframe).T_world_lidar * T_kf_sweep});
+  }
+  return out;
+}
 
 const std::deque<StampedPose>& LidarOdometry::recentImuRate() const { return impl_->imu_rate; }
 

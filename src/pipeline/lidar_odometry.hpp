@@ -122,8 +122,9 @@ class LidarOdometry {
   std::vector<ScanOutcome> finish();
 
   // T_world_lidar at every processed sweep's start; after a loop closure every pose is re-expressed relative to
-  // its keyframe's corrected pose (the pose relative to the keyframe the sweep followed is kept).
-  const Trajectory& trajectory() const;
+  // its keyframe's corrected pose (the pose relative to the keyframe the sweep followed is kept). Built on each
+  // call from the keyframes' poses (O(sweeps)): call it once, not per sweep.
+  Trajectory trajectory() const;
   Trajectory keyframeTrajectory() const;    // T_world_lidar of the keyframes
   // IMU-rate odometry (LIO-SAM's imuPreintegration output), T_world_imu at every accepted IMU sample after the
   // initialisation: the newest fused state propagated by the IMU as each sample arrives, i.e. what a live system

@@ -24,7 +24,7 @@ std::vector<ScanOutcome> LidarOdometry::Impl::onScan(LidarScan scan) {
   ++stats.scans_in;
   scan.t += calibration.lidar_time_offset;
   scan.t_end += calibration.lidar_time_offset;
-  const Time last = !pending.empty() ? pending.back().t : (!trajectory.empty() ? trajectory.back().t : scan.t - 1);
+  const Time last = !pending.empty() ? pending.back().t : (!recent.empty() ? recent.back().t : scan.t - 1);
   if (scan.t <= last) {
     ++stats.scans_skipped_time;
     notice(fmt::format("sweep at {:.6f} s skipped: its stamp is not after the previous sweep's ({:.6f} s)",
@@ -41,7 +41,7 @@ std::vector<ScanOutcome> LidarOdometry::Impl::drain(bool force) {
   std::vector<ScanOutcome> out;
   while (!pending.empty()) {
     LidarScan& scan = pending.front();
-    const Time end = fusion.coverageNeeded(scan.t, std::max(scan.t, scan.t_end), trajectory.empty());
+    const Time end = fusion.coverageNeeded(scan.t, std::max(scan.t, scan.t_end), recent.empty());
     const bool waiting = fusion.wantsImu() && fusion.latestImuTime() < end;
     const bool overdue = pending.back().t > end + fromSeconds(config.imu_wait);
     if (waiting && !force && !overdue) break;
@@ -59,14 +59,14 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   if (!preprocess(scan, out)) return std::nullopt;
   out.ms.preprocess = msSince(t0);
 
-  if (config.use_imu) fusion.tryInitialize(scan.t, trajectory.empty());
+  if (config.use_imu) fusion.tryInitialize(scan.t, recent.empty());
   std::optional<lidar::SweepMotion> motion;
   if (config.deskew) {
     motion = fusion.sweepMotion(scan.t, scan.t_end);
     out.imu_used = motion.has_value();
-    if (!motion && trajectory.size() >= 2) {
-      const StampedPose& a = trajectory[trajectory.size() - 2];
-      const StampedPose& b = trajectory.back();
+    if (!motion && recent.size() >= 2) {
+      const StampedPose& a = recent[recent.size() - 2];
+      const StampedPose& b = recent.back();
       motion = lidar::constantVelocityMotion(a.T_world_body.inverse() * b.T_world_body, toSeconds(b.t - a.t));
     }
   }
@@ -76,9 +76,9 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   lidar::FeatureSet features = deskewAndExtract(scan, motion, out);
   match(features, T_guess, out);
   // Constant-velocity deskew: again with the sweep's own estimated motion (see deskew_refinements).
-  const bool refine = motion && !out.imu_used && !trajectory.empty() && map.size() > map_first_keyframe;
+  const bool refine = motion && !out.imu_used && !recent.empty() && map.size() > map_first_keyframe;
   for (int k = 0; refine && out.match_usable && k < config.deskew_refinements; ++k) {
-    const StampedPose& prev = trajectory.back();
+    const StampedPose& prev = recent.back();
     motion = lidar::constantVelocityMotion(prev.T_world_body.inverse() * out.T_world_lidar, toSeconds(scan.t - prev.t));
     features = deskewAndExtract(scan, motion, out);
     match(features, out.T_world_lidar, out);
@@ -86,7 +86,7 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   countMatch(out);
 
   t0 = Clock::now();
-  fusion.update(out, trajectory);
+  fusion.update(out, recent);
   out.ms.smoother = msSince(t0);
   if (out.reset) {
     ++stats.smoother_resets;
@@ -133,10 +133,10 @@ Eigen::Isometry3d LidarOdometry::Impl::guess(Time t, bool& from_imu) const {
     return *p;
   }
   from_imu = false;
-  if (trajectory.empty()) return fusion.initialLidarPose();
-  if (trajectory.size() == 1) return trajectory.back().T_world_body;
-  const StampedPose& a = trajectory[trajectory.size() - 2];
-  const StampedPose& b = trajectory.back();
+  if (recent.empty()) return fusion.initialLidarPose();
+  if (recent.size() == 1) return recent.back().T_world_body;
+  const StampedPose& a = recent[recent.size() - 2];
+  const StampedPose& b = recent.back();
   return constantVelocityGuess(b.T_world_body, a.T_world_body.inverse() * b.T_world_body, toSeconds(b.t - a.t),
                                toSeconds(t - b.t));
 }
@@ -284,8 +284,8 @@ Eigen::Isometry3d LidarOdometry::Impl::correctKeyframes(const std::vector<Eigen:
   const std::size_t last = poses.size() - 1;
   const Eigen::Isometry3d T_new_old = poses[last] * map.keyframe(last).T_world_lidar.inverse();
   for (std::size_t i = 0; i < poses.size(); ++i) map.updatePose(i, poses[i]);
-  for (std::size_t i = 0; i < trajectory.size(); ++i)
-    trajectory[i].T_world_body = poses[anchors[i].keyframe] * anchors[i].T_kf_sweep;
+  for (std::size_t i = 0; i < recent.size(); ++i)
+    recent[i].T_world_body = poses[anchors[anchors.size() - recent.size() + i].keyframe] * recent_kf_sweep[i];
   T_world_lastkf = poses[last];
   prebuild_center = T_world_lastkf.translation();
   return T_new_old;
@@ -293,8 +293,15 @@ Eigen::Isometry3d LidarOdometry::Impl::correctKeyframes(const std::vector<Eigen:
 
 void LidarOdometry::Impl::record(const ScanOutcome& out) {
   const std::size_t kf = map.size() - 1;
-  anchors.push_back({kf, map.keyframe(kf).T_world_lidar.inverse() * out.T_world_lidar});
-  trajectory.push_back({out.t, out.T_world_lidar});
+  const Eigen::Isometry3d T_kf_sweep = map.keyframe(kf).T_world_lidar.inverse() * out.T_world_lidar;
+  anchors.push_back({out.t, static_cast<std::uint32_t>(kf), Eigen::Quaterniond(T_kf_sweep.linear()).normalized(),
+                     T_kf_sweep.translation()});
+  recent.push_back({out.t, out.T_world_lidar});
+  recent_kf_sweep.push_back(T_kf_sweep);
+  if (recent.size() > 2) {
+    recent.erase(recent.begin());
+    recent_kf_sweep.erase(recent_kf_sweep.begin());
+  }
 }
 
 }  // namespace drover::pipeline

@@ -198,9 +198,9 @@ TEST(LidarOdometry, PreparingTheMapBetweenSweepsChangesNoPose) {
   plain.finish();
   prepared.finish();
   EXPECT_EQ(built, prepared.stats().keyframes);  // once after each keyframe
-  ASSERT_EQ(plain.trajectory().size(), prepared.trajectory().size());
-  for (std::size_t i = 0; i < plain.trajectory().size(); ++i)
-    EXPECT_EQ(plain.trajectory()[i].T_world_body.matrix(), prepared.trajectory()[i].T_world_body.matrix()) << i;
+  const Trajectory a = plain.trajectory(), b = prepared.trajectory();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].T_world_body.matrix(), b[i].T_world_body.matrix()) << i;
 }
 
 TEST(LidarOdometry, WithoutTheImuThereIsNoImuRateOdometry) {
