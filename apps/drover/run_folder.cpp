@@ -34,12 +34,17 @@ std::atomic<int> g_signal{0};
 static_assert(std::atomic<int>::is_always_lock_free, "read in a signal handler");
 
 extern "C" void onStopSignal(int signal) {
-  g_signal.store(signal);
+  int none = 0;
+  const bool first = g_signal.compare_exchange_strong(none, signal);
   struct sigaction fallback {};
   fallback.sa_handler = SIG_DFL;
   sigemptyset(&fallback.sa_mask);
   sigaction(SIGINT, &fallback, nullptr);  // the second signal, either one, kills
   sigaction(SIGTERM, &fallback, nullptr);
+  // The sa_mask below holds the other signal back only in the thread running this handler: with the run's threads
+  // the second can arrive in another thread while the first is here (seen: 2 runs in 6 under load exited 143 after
+  // a SIGTERM and a SIGINT). That one is the second: pending on this thread, it kills once the handler returns.
+  if (!first) raise(signal);
 }
 
 }  // namespace
