@@ -68,6 +68,7 @@ struct Lap {
   std::size_t graph_refusals = 0;        // verified loops the pose graph failed to solve (cumulative)
   double graph_iterations = 0;           // mean iterations of the re-solves of this lap's accepted loops
   double max_rotation = 0;               // [rad] largest implied rotation of this lap's accepted loops
+  std::size_t graph_nodes = 0;           // pose-graph nodes (keyframes less those merged on retirement)
 };
 
 // The loop closure's counts: loops the pose graph refused (verified, within the drift budget, rolled back because
@@ -75,6 +76,7 @@ struct Lap {
 // rotation a loop implied.
 void loopCounts(const pipeline::LoopClosure& loops, std::size_t first_event, Lap& row) {
   row.loop_stats = loops.stats();
+  row.graph_nodes = loops.graphNodes();
   std::size_t solves = 0, iterations = 0;
   const std::vector<pipeline::LoopEvent>& events = loops.events();
   for (std::size_t i = 0; i < events.size(); ++i) {
@@ -294,7 +296,7 @@ int main(int argc, char** argv) {
   const auto wall0 = std::chrono::steady_clock::now();
   std::printf("%s: lap  data_s  wall_s  sweeps  keyframes  retired  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  "
               "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms  iterations  "
-              "max_rot_deg\n",
+              "max_rot_deg  graph_nodes\n",
               mode.c_str());
   for (int lap = 0; lap < laps; ++lap) {
     const Time offset = lap * lap_span;
@@ -321,11 +323,12 @@ int main(int argc, char** argv) {
     rows.push_back(row);
     const pipeline::LoopStats& ls = row.loop_stats;
     std::printf("%3d  %6.0f  %6.0f  %6zu  %9zu  %7zu  %5zu  %7zu  %6.1f  %7.1f  %9.1f  %10.1f  %8.1f  %5.1f  | %8zu  "
-                "%8zu  %11zu  %13zu  %8.0f  %10.1f  %11.1f\n",
+                "%8zu  %11zu  %13zu  %8.0f  %10.1f  %11.1f  %11zu\n",
                 row.lap, row.data_s, row.wall_s, row.sweeps, row.keyframes, row.retired, row.loops, row.dropped,
                 row.rss_kb / 1024.0, row.peak_kb / 1024.0, row.kf_lis / 1048576.0, row.kf_loop / 1048576.0,
                 row.cache / 1048576.0, row.descriptors / 1048576.0, ls.verified, ls.accepted, ls.over_drift_budget,
-                row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / std::numbers::pi);
+                row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / std::numbers::pi,
+                row.graph_nodes);
     std::fflush(stdout);
   }
   runner->finish();

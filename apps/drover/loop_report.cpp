@@ -120,7 +120,9 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
          {"descriptor_ms_total", s.descriptor_ms},
          {"query_ms_total", s.query_ms},
          {"verify_ms_total", s.verify_ms},
-         {"graph_ms_total", s.graph_ms}};
+         {"graph_ms_total", s.graph_ms},
+         {"graph_nodes", loops.graphNodes()},
+         {"retired_nodes_merged", s.merged}};
   Json events = Json::array();
   std::size_t correct = 0, judged = 0, same_shift = 0, compared = 0;
   std::vector<bool> closed_ok(odometry.keyframeTrajectory().size(), false);

@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "backend/pose_factors.hpp"
+#include "backend/pose_graph_merge.hpp"
 #include "backend/quaternion_manifold.hpp"
 
 namespace drover::backend {
@@ -110,7 +111,8 @@ struct PoseGraph::Impl {
   RightQuaternionManifold manifold;
   std::unique_ptr<ceres::LossFunction> loop_loss;
   std::map<int, NodeBlock> nodes;  // std::map: block addresses stay put as nodes are added
-  std::vector<EdgeEntry> edges;
+  std::map<std::size_t, EdgeEntry> edges;  // by index; a map so that merged edges can leave
+  std::size_t next_edge = 0;
   std::size_t enabled_edges = 0;
   ceres::Problem problem;  // declared last: destroyed before the manifold and the loss it points to
 
@@ -129,10 +131,17 @@ struct PoseGraph::Impl {
     return it->second;
   }
   EdgeEntry& edgeAt(std::size_t index) {
-    if (index >= edges.size())
-      throw std::invalid_argument("PoseGraph: edge index " + std::to_string(index) + " out of range (" +
+    const auto it = edges.find(index);
+    if (it == edges.end())
+      throw std::invalid_argument("PoseGraph: edge index " + std::to_string(index) + " out of range (no such edge; " +
                                   std::to_string(edges.size()) + " edges)");
-    return edges[index];
+    return it->second;
+  }
+  void removeResidual(EdgeEntry& e) {
+    if (!e.block) return;
+    problem.RemoveResidualBlock(e.block);  // deletes the factor; re-enabling makes a new one
+    e.block = nullptr;
+    --enabled_edges;
   }
   void addResidual(EdgeEntry& e) {
     const PoseGraphEdge& d = e.edge;
@@ -151,9 +160,23 @@ struct PoseGraph::Impl {
   std::size_t add(PoseGraphEdge edge, const std::string& what) {
     checkPose(edge.T_from_to_measured, what + ": measurement");
     EdgeEntry entry{edge, sqrtInformation(edge.information, what), nullptr};
-    edges.push_back(std::move(entry));
-    addResidual(edges.back());
-    return edges.size() - 1;
+    const std::size_t index = next_edge++;
+    EdgeEntry& stored = edges.emplace(index, std::move(entry)).first->second;
+    if (stored.edge.enabled) addResidual(stored);
+    return index;
+  }
+  // An enabled edge of the same kind, from and to as `e`, if any.
+  EdgeEntry* parallelTo(const PoseGraphEdge& e) {
+    for (auto& [index, other] : edges)
+      if (other.edge.enabled && other.edge.kind == e.kind && other.edge.from == e.from && other.edge.to == e.to)
+        return &other;
+    return nullptr;
+  }
+  void replace(EdgeEntry& entry, const PoseGraphEdge& edge, const std::string& what) {
+    removeResidual(entry);
+    entry.edge = edge;
+    entry.sqrt_information = sqrtInformation(edge.information, what);
+    addResidual(entry);
   }
 };
 
@@ -230,7 +253,48 @@ std::size_t PoseGraph::addPrior(int id, const Eigen::Isometry3d& T_world_node_me
   return impl_->add(PoseGraphEdge{id, id, T_world_node_measured, information, EdgeKind::kPrior, true}, what);
 }
 
+void PoseGraph::mergeNode(int id, int into) {
+  const std::string what = "PoseGraph::mergeNode " + idText(id) + " into " + idText(into);
+  if (id == into) throw std::invalid_argument(what + ": a node cannot be merged into itself");
+  NodeBlock& gone = impl_->node(id, "PoseGraph::mergeNode");
+  impl_->node(into, "PoseGraph::mergeNode");
+  const Eigen::Isometry3d T_id_into = gone.get().inverse() * pose(into);
+  std::vector<PoseGraphEdge> moved;
+  for (auto it = impl_->edges.begin(); it != impl_->edges.end();) {
+    EdgeEntry& e = it->second;
+    if (e.edge.from != id && e.edge.to != id) {
+      ++it;
+      continue;
+    }
+    const PoseGraphEdge& d = e.edge;
+    const bool between = d.from == into || d.to == into;  // now inside one rigid body: no information left
+    if (d.enabled && !between)
+      moved.push_back(d.from == id && d.kind != EdgeKind::kPrior ? moveFromEnd(d, into, T_id_into)
+                                                                  : moveToEnd(d, into, T_id_into));
+    impl_->removeResidual(e);
+    it = impl_->edges.erase(it);
+  }
+  for (const PoseGraphEdge& m : moved) {
+    if (EdgeEntry* parallel = impl_->parallelTo(m)) {
+      impl_->replace(*parallel, fuseParallel(parallel->edge, m), what);
+    } else {
+      impl_->add(m, what);
+    }
+  }
+  if (gone.fixed) setFixed(into, true);
+  impl_->problem.RemoveParameterBlock(gone.p);
+  impl_->problem.RemoveParameterBlock(gone.q);
+  impl_->nodes.erase(id);
+}
+
 std::size_t PoseGraph::edgeCount() const { return impl_->edges.size(); }
+
+std::vector<std::size_t> PoseGraph::edgeIndices() const {
+  std::vector<std::size_t> out;
+  out.reserve(impl_->edges.size());
+  for (const auto& [index, e] : impl_->edges) out.push_back(index);
+  return out;
+}
 std::size_t PoseGraph::enabledEdgeCount() const { return impl_->enabled_edges; }
 
 const PoseGraphEdge& PoseGraph::edge(std::size_t index) const { return impl_->edgeAt(index).edge; }
@@ -242,9 +306,7 @@ void PoseGraph::setEdgeEnabled(std::size_t index, bool enabled) {
   if (enabled) {
     impl_->addResidual(e);
   } else {
-    impl_->problem.RemoveResidualBlock(e.block);  // deletes the factor; re-enabling makes a new one
-    e.block = nullptr;
-    --impl_->enabled_edges;
+    impl_->removeResidual(e);
   }
 }
 

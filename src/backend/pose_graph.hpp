@@ -118,10 +118,21 @@ class PoseGraph {
   std::size_t addPrior(int id, const Eigen::Isometry3d& T_world_node_measured, const Matrix6d& information);
   std::size_t edgeCount() const;         // all edges, disabled ones included
   std::size_t enabledEdgeCount() const;
-  const PoseGraphEdge& edge(std::size_t index) const;  // out of range -> invalid_argument
+  std::vector<std::size_t> edgeIndices() const;        // of every edge there is, ascending
+  const PoseGraphEdge& edge(std::size_t index) const;  // no such edge (never added, or merged) -> invalid_argument
   // A disabled edge stays in the list (indices do not move) but takes no part in optimize() or cost() -- e.g. a
   // loop closure that proved wrong. Out of range -> invalid_argument.
   void setEdgeEnabled(std::size_t index, bool enabled);
+
+  // Merges node `id` into node `into`: their relative pose, at the current estimate, is held rigid from now on
+  // and `id` leaves the graph, so a graph whose places are revisited stays as large as the places (keyframe
+  // retirement). Every enabled edge of `id` is re-expressed on `into` with the same error up to a linear map A
+  // (exact for the `from` end, first order for the `to` end and priors) and information A^-T I A^-1; edges
+  // between the two are dropped, as are `id`'s disabled edges. An edge that then parallels an enabled one of the
+  // same kind, from and to, is fused into it (first order: information I1 + I2, measurement moved by
+  // (I1 + I2)^-1 I2 d). A fixed `id` fixes `into` (the gauge). Re-expressed edges get new indices; the old ones
+  // are gone. Throws std::invalid_argument for unknown ids or id == into.
+  void mergeNode(int id, int into);
 
   // Cost 0.5 sum rho(|r|^2) of the enabled edges at the current poses (no solve).
   double cost() const;

@@ -96,8 +96,10 @@ struct KeyframeRecord {
   Eigen::Isometry3d T_previous_this = Eigen::Isometry3d::Identity();   // relative to the previous keyframe
   geometry::Matrix6d degenerate_cov = geometry::Matrix6d::Zero();      // as LoopClosure::addKeyframe takes it
   // Older keyframes this one's arrival retired (LocalMap::supersededBy, decided with the LIS's poses now): a copy of
-  // the map retires them too, after this keyframe's loop search (LoopClosure::retire as well).
+  // the map retires them too, after this keyframe's loop search (LoopClosure::retire as well). Ascending;
+  // retired_by[k] is the newer keyframe that stands for retired[k].
   std::vector<std::size_t> retired;
+  std::vector<std::size_t> retired_by;
 };
 
 // Keyframe poses corrected by an accepted loop (LIO-SAM's correctPoses input): T_world_lidar of keyframes

@@ -80,7 +80,8 @@ struct LidarOdometry::Impl {
     if (stats.notices.size() < OdometryStats::kMaxNotices) stats.notices.push_back(std::move(line));
   }
   void keyframe(const lidar::FeatureSet& features, ScanOutcome& out);
-  std::vector<std::size_t> supersededKeyframes();
+  // (retired, superseded by), ascending in the retired one
+  std::vector<std::pair<std::size_t, std::size_t>> supersededKeyframes();
   void accumulateDegeneracy(const ScanOutcome& out);
   void applyLoopCorrection(ScanOutcome& out);
   Eigen::Isometry3d correctKeyframes(const std::vector<Eigen::Isometry3d>& poses);

@@ -220,19 +220,24 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
   out.keyframe = true;
   ++stats.keyframes;
   const auto t0 = Clock::now();
-  std::vector<std::size_t> retired = supersededKeyframes();
+  const std::vector<std::pair<std::size_t, std::size_t>> retired = supersededKeyframes();
   if (keyframe_listener) {
     const Eigen::Isometry3d T_previous = index > 0 ? map.keyframe(index - 1).T_world_lidar : out.T_world_lidar;
-    keyframe_listener(KeyframeRecord{index, out.t, map.keyframe(index).shared, out.T_world_lidar,
-                                     T_previous.inverse() * out.T_world_lidar, degenerate_since_kf, retired});
+    KeyframeRecord record{index, out.t, map.keyframe(index).shared, out.T_world_lidar,
+                          T_previous.inverse() * out.T_world_lidar, degenerate_since_kf, {}, {}};
+    for (const auto& [i, by] : retired) {
+      record.retired.push_back(i);
+      record.retired_by.push_back(by);
+    }
+    keyframe_listener(std::move(record));
   }
   const bool closed = !external_loops && loops.addKeyframe(map, index, degenerate_since_kf);
   degenerate_since_kf.setZero();
   if (closed) applyLoopCorrection(out);
   // After the search, as the live loop thread does it: this keyframe's search still saw the retired ones.
-  for (std::size_t i : retired) {
+  for (const auto& [i, by] : retired) {
     map.retire(i);
-    if (!external_loops) loops.retire(i);
+    if (!external_loops) loops.retire(i, by);
   }
   stats.keyframes_retired += retired.size();
   out.ms.loop = msSince(t0);
@@ -240,17 +245,18 @@ void LidarOdometry::Impl::keyframe(const lidar::FeatureSet& features, ScanOutcom
 
 // The keyframes superseded by those that became retire_age old with the newest keyframe (LocalMapConfig): each
 // keyframe is looked at once, when it is that old, so its own loop search has long been made.
-std::vector<std::size_t> LidarOdometry::Impl::supersededKeyframes() {
-  std::vector<std::size_t> out;
+std::vector<std::pair<std::size_t, std::size_t>> LidarOdometry::Impl::supersededKeyframes() {
+  std::vector<std::pair<std::size_t, std::size_t>> out;
   const std::size_t newest = map.size() - 1;
   if (map.config().retire_radius <= 0) return out;
   const Time latest = map.keyframe(newest).t - fromSeconds(map.config().retire_age);
   for (; retire_next < newest && map.keyframe(retire_next).t <= latest; ++retire_next) {
-    const std::vector<std::size_t> superseded = map.supersededBy(retire_next);
-    out.insert(out.end(), superseded.begin(), superseded.end());
+    for (std::size_t i : map.supersededBy(retire_next)) out.emplace_back(i, retire_next);
   }
+  // Sorted by the retired keyframe, its first (oldest) superseder kept.
   std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  out.erase(std::unique(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+            out.end());
   return out;
 }
 

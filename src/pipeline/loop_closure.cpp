@@ -72,6 +72,23 @@ struct LoopClosure::Impl {
   LoopStats stats;
   VisualYawPrior visual_prior;
   int skip = 0;
+  // By keyframe: the newer keyframe its graph node was merged into (-1: its own node) and its pose in that one's.
+  struct Merged {
+    long long into = -1;
+    Eigen::Quaterniond q_into_kf = Eigen::Quaterniond::Identity();
+    Eigen::Vector3d p_into_kf = Eigen::Vector3d::Zero();
+  };
+  std::vector<Merged> merged;
+  std::vector<std::pair<std::size_t, std::size_t>> accepted_loops;  // (candidate, query) keyframe indices
+
+  // An accepted loop joins the neighbourhoods (+-submap_keyframes) of keyframes `older` and `newer`.
+  bool loopBetween(std::size_t older, std::size_t newer) const {
+    const auto near = [&](std::size_t a, std::size_t b) {
+      return (a > b ? a - b : b - a) <= static_cast<std::size_t>(config.submap_keyframes);
+    };
+    return std::any_of(accepted_loops.begin(), accepted_loops.end(),
+                       [&](const auto& l) { return near(l.first, older) && near(l.second, newer); });
+  }
 
   explicit Impl(const LoopClosureConfig& c) : config(c), database(c.database), verifier(c.verifier), graph(c.graph) {}
 
@@ -115,6 +132,7 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   const lidar::Keyframe& kf = map.keyframe(index);
   m.times.push_back(kf.t);
   m.searched.push_back(false);
+  m.merged.emplace_back();
   m.degenerate_before.push_back((m.degenerate_before.empty() ? 0.0 : m.degenerate_before.back()) +
                                 degenerate_cov.trace());
   m.degenerate_rotation_before.push_back(
@@ -260,6 +278,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
     } else {
       e.correction = (graph.pose(static_cast<int>(index)).translation() - before).norm();
       ++stats.accepted;
+      accepted_loops.emplace_back(c.index, index);
     }
   }
   events.push_back(e);
@@ -302,21 +321,53 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
 
 void LoopClosure::setVisualYawPrior(VisualYawPrior prior) { impl_->visual_prior = std::move(prior); }
 
-void LoopClosure::retire(std::size_t index) {
-  if (index >= impl_->times.size())
-    throw std::invalid_argument(fmt::format("loop closure: cannot retire keyframe {} of {}", index, impl_->times.size()));
-  if (impl_->config.enabled) impl_->database.remove(static_cast<int>(index));
-  // Its graph node stays free: held fixed, a first pass could no longer follow the loops a later pass closes (on
-  // kitti05-replay the APE went from 0.42 to 0.71 m).
-  ++impl_->stats.retired;
+void LoopClosure::retire(std::size_t index, std::size_t by) {
+  Impl& m = *impl_;
+  if (by >= m.times.size() || index >= by)
+    throw std::invalid_argument(
+        fmt::format("loop closure: cannot retire keyframe {} for keyframe {} of {}", index, by, m.times.size()));
+  if (m.config.enabled) m.database.remove(static_cast<int>(index));
+  ++m.stats.retired;
+  if (m.config.keep_retired_nodes || m.merged[index].into >= 0) return;
+  // Only where a loop has tied the two passes together is their estimated relative pose worth freezing: the odometry
+  // alone may have drifted tens of metres by then (farm course: 56 m before its first loop), and a pass that merely
+  // crosses the estimate of another would be bolted to the wrong place (one pass: APE 3.6 -> 24.8 m).
+  if (!m.loopBetween(index, by)) {
+    ++m.stats.unmerged;
+    return;
+  }
+  // `by` may itself have been merged (a retired keyframe can still stand for an older place): its node's owner.
+  std::size_t into = by;
+  while (m.merged[into].into >= 0) into = static_cast<std::size_t>(m.merged[into].into);
+  // Merged, not held fixed: a frozen first pass could not follow the loops a later pass closes (kitti05-replay
+  // APE 0.42 -> 0.71 m); merged, it moves with the pass that stands for it.
+  const Eigen::Isometry3d T_into_kf =
+      m.graph.pose(static_cast<int>(into)).inverse() * m.graph.pose(static_cast<int>(index));
+  m.graph.mergeNode(static_cast<int>(index), static_cast<int>(into));
+  m.merged[index] = {static_cast<long long>(into), Eigen::Quaterniond(T_into_kf.linear()).normalized(),
+                     T_into_kf.translation()};
+  ++m.stats.merged;
 }
+
+std::size_t LoopClosure::graphNodes() const { return impl_->graph.size(); }
 
 std::size_t LoopClosure::descriptorBytes() const { return impl_->database.descriptorBytes(); }
 
 std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
-  std::vector<Eigen::Isometry3d> out;
-  out.reserve(impl_->times.size());
-  for (std::size_t i = 0; i < impl_->times.size(); ++i) out.push_back(impl_->graph.pose(static_cast<int>(i)));
+  const std::size_t n = impl_->times.size();
+  std::vector<Eigen::Isometry3d> out(n, Eigen::Isometry3d::Identity());
+  // Newest first: a merged keyframe's owner is newer, so its pose is already there.
+  for (std::size_t i = n; i-- > 0;) {
+    const Impl::Merged& m = impl_->merged[i];
+    if (m.into < 0) {
+      out[i] = impl_->graph.pose(static_cast<int>(i));
+      continue;
+    }
+    Eigen::Isometry3d T_into_kf = Eigen::Isometry3d::Identity();
+    T_into_kf.linear() = m.q_into_kf.toRotationMatrix();
+    T_into_kf.translation() = m.p_into_kf;
+    out[i] = out[static_cast<std::size_t>(m.into)] * T_into_kf;
+  }
   return out;
 }
 

@@ -58,6 +58,9 @@ struct LoopClosureConfig {
   double max_rotation_drift_floor = 0.2;      // [rad] (11 deg)
   double max_rotation_drift_ratio = 0.0005;   // [rad/m] (2.9 deg per 100 m)
   double degenerate_rotation_drift = 0.05;    // [rad] per degenerate direction of a sweep
+  // Retired keyframes keep their own graph node (LIO-SAM: the graph grows with time). Off by default: a retired
+  // keyframe's node is merged into the newer keyframe that stands for its place (see retire()).
+  bool keep_retired_nodes = false;
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };
@@ -88,6 +91,8 @@ struct LoopStats {
   std::size_t narrowed_searches = 0, fallbacks = 0;  // prior-narrowed shift searches, and their fall-backs
   std::size_t visual_priors = 0;                     // shift searches whose prior came from the VisualYawPrior
   std::size_t retired = 0;                           // keyframes retired (retire()): no longer candidates
+  std::size_t merged = 0;                            // of them, graph nodes merged into a newer keyframe's
+  std::size_t unmerged = 0;                          // of them, kept as nodes: no accepted loop linked the places
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
 };
 
@@ -112,10 +117,15 @@ class LoopClosure {
   // The shift search's prior comes from `prior` when it returns one, else from the current estimate (when
   // config.yaw_prior). An empty function removes it. The VIS fills this in later; until then only the estimate.
   void setVisualYawPrior(VisualYawPrior prior);
-  // Keyframe `index` was retired from the map (LocalMap::retire): its Scan Context leaves the database and it is no
-  // longer a radius candidate (its graph node and edges stay). Call after retiring it in the map given to
-  // addKeyframe.
-  void retire(std::size_t index);
+  // Keyframe `index` was retired from the map (LocalMap::retire) because keyframe `by` (newer) stands for its
+  // place: its Scan Context leaves the database, it is no longer a radius candidate, and, when an accepted loop
+  // joins the two places (a loop between keyframes within submap_keyframes of each), its graph node is merged into
+  // `by`'s (PoseGraph::mergeNode): their relative pose at the current estimate is held rigid from now on and
+  // poses() gives it as `by`'s pose times that. So the graph, like the map, grows with the area driven, not the
+  // time (with keep_retired_nodes, or without such a loop, the node stays free). Call after retiring it in the map given to
+  // addKeyframe. Throws std::invalid_argument for an unknown index or by <= index.
+  void retire(std::size_t index, std::size_t by);
+  std::size_t graphNodes() const;  // nodes in the pose graph (keyframes less the merged ones)
   std::size_t descriptorBytes() const;  // [bytes] the database's stored descriptors
 
   std::vector<Eigen::Isometry3d> poses() const;  // T_world_lidar of every keyframe from the graph, by index

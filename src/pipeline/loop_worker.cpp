@@ -17,9 +17,9 @@ std::optional<LoopCorrection> LoopWorker::add(const KeyframeRecord& kf) {
   // After the search, as the in-line loop closure does, and also when the search throws (the System goes on with
   // the next keyframe): the retired clouds are not kept here.
   const auto retire = [&] {
-    for (std::size_t i : kf.retired) {
-      map_.retire(i);
-      loops_.retire(i);
+    for (std::size_t k = 0; k < kf.retired.size(); ++k) {
+      map_.retire(kf.retired[k]);
+      loops_.retire(kf.retired[k], kf.retired_by.at(k));
     }
   };
   std::optional<LoopCorrection> c;

@@ -399,6 +399,7 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   max_rotation_drift_floor: 0.3
   max_rotation_drift_ratio: 0.001
   degenerate_rotation_drift: 0.02
+  keep_retired_nodes: true
   scan_context:
     sensor_height: 1.5
     auto_height: true
@@ -423,6 +424,7 @@ odometry:
   EXPECT_EQ(c.loop.max_rotation_drift_floor, 0.3);
   EXPECT_EQ(c.loop.max_rotation_drift_ratio, 0.001);
   EXPECT_EQ(c.loop.degenerate_rotation_drift, 0.02);
+  EXPECT_TRUE(c.loop.keep_retired_nodes);
   EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
   EXPECT_TRUE(c.loop.database.descriptor.auto_height);
   EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);

@@ -279,6 +279,9 @@ TEST_F(SimRun, TheReportCarriesTheLoopRecordAndNoLoopTurnsTheSearchOff) {
   EXPECT_TRUE(loops["events"].is_array());
   EXPECT_EQ(loops["precision"], 1.0);  // with ground truth: judged (no loop, so nothing false)
   EXPECT_EQ(loops["searched_keyframes_with_revisit"], 0);
+  // Nothing revisited, nothing retired: a graph node per keyframe.
+  EXPECT_EQ(loops["graph_nodes"], r["counts"]["keyframes"]);
+  EXPECT_EQ(loops["retired_nodes_merged"], 0);
   EXPECT_TRUE(r["timings"].contains("loop"));
 
   ASSERT_EQ(noloop_.exit_code, 0) << noloop_.output;

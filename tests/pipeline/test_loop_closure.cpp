@@ -6,9 +6,11 @@
 #include <algorithm>
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include "eval/ape.hpp"
+#include "geometry/so3.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "pipeline/loop_closure.hpp"
 #include "sim/scenario.hpp"
@@ -214,6 +216,57 @@ TEST(LoopClosure, AVisualYawPriorIsUsedForTheShiftSearchWhenItHasOne) {
     }
 }
 
+// Two laps of 36 keyframes round the courtyard with 1 cm and 0.1 deg of odometry error a step (the second lap
+// starts 0.36 m and 3.6 deg off the first); the loops found are applied as the LIS does.
+std::unique_ptr<LoopClosure> twoLaps(const LoopClosureConfig& c) {
+  auto loops = std::make_unique<LoopClosure>(c);
+  lidar::LocalMap map;
+  for (int i = 0; i < 72; ++i) {
+    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
+    f.t = fromSeconds(i);
+    if (loops->addKeyframe(map, map.addKeyframe(f, lapPose(i) * test::planarPose(0.01 * i, 0, 0.1 * i)),
+                           geometry::Matrix6d::Zero())) {
+      const std::vector<Eigen::Isometry3d> poses = loops->poses();
+      for (std::size_t k = 0; k < poses.size(); ++k) map.updatePose(k, poses[k]);
+    }
+  }
+  return loops;
+}
+
+// The second lap retires the first's keyframes, each by its twin a lap later. Where loops tied the laps together
+// the retired nodes merge and poses() still gives every keyframe where it was; with no loop (search disabled) or
+// with keep_retired_nodes, the graph keeps them all.
+TEST(LoopClosure, ARetiredKeyframesGraphNodeIsMergedWhereALoopTiedItsPlaceToTheNewerOne) {
+  for (const int mode : {0, 1, 2}) {  // merge, keep_retired_nodes, no loops
+    LoopClosureConfig c = courtyardConfig();
+    c.keep_retired_nodes = mode == 1;
+    c.enabled = mode != 2;
+    const std::unique_ptr<LoopClosure> loops = twoLaps(c);
+    if (mode != 2) {
+      ASSERT_GE(loops->stats().accepted, 10u);
+    }
+    const std::vector<Eigen::Isometry3d> before = loops->poses();
+    for (std::size_t i = 0; i < 36; ++i) loops->retire(i, i + 36);
+    EXPECT_EQ(loops->stats().retired, 36u);
+    const std::size_t merged = loops->stats().merged;
+    if (mode == 0) {
+      EXPECT_GE(merged, 30u) << "loops everywhere on the second lap: nearly every place is tied";
+    } else {
+      EXPECT_EQ(merged, 0u);
+    }
+    EXPECT_EQ(merged + loops->stats().unmerged, mode == 1 ? 0u : 36u);
+    EXPECT_EQ(loops->graphNodes(), 72u - merged);
+    const std::vector<Eigen::Isometry3d> after = loops->poses();
+    ASSERT_EQ(after.size(), 72u);
+    for (std::size_t i = 0; i < 72; ++i) {
+      EXPECT_LT((after[i].translation() - before[i].translation()).norm(), 1e-9) << i;
+      EXPECT_LT(geometry::logSO3(after[i].linear().transpose() * before[i].linear()).norm(), 1e-9) << i;
+    }
+  }
+  LoopClosure loops{courtyardConfig()};
+  EXPECT_THROW(loops.retire(0, 0), std::invalid_argument);
+}
+
 TEST(LoopClosure, DisabledItStillKeepsTheGraphButNeverSearches) {
   LoopClosureConfig c = courtyardConfig();
   c.enabled = false;
@@ -242,7 +295,7 @@ TEST(LoopClosure, RejectsInvalidConfigsAndOutOfOrderKeyframes) {
   c.max_rotation_drift_floor = 0;
   EXPECT_NE(c.validate().find("max_rotation_drift_floor"), std::string::npos);
   LoopClosure loops{LoopClosureConfig{}};
-  EXPECT_THROW(loops.retire(0), std::invalid_argument);
+  EXPECT_THROW(loops.retire(0, 1), std::invalid_argument);
   lidar::LocalMap map;
   map.addKeyframe(test::courtyard(0), Eigen::Isometry3d::Identity());
   map.addKeyframe(test::courtyard(0), Eigen::Isometry3d::Identity());
@@ -256,6 +309,7 @@ struct OverlapRun {
   std::vector<LoopEvent> events;
   LoopStats stats;
   OdometryStats odometry;
+  std::size_t graph_nodes = 0;
   std::vector<lidar::Keyframe> keyframes;  // as they ended (poses corrected, the retired ones marked)
 };
 
@@ -288,6 +342,7 @@ const OverlapRun& overlap() {
     out.events = odometry.loopClosure().events();
     out.stats = odometry.loopClosure().stats();
     out.odometry = odometry.stats();
+    out.graph_nodes = odometry.loopClosure().graphNodes();
     for (std::size_t i = 0; i < odometry.keyframeMap().size(); ++i) out.keyframes.push_back(odometry.keyframeMap().keyframe(i));
     return out;
   }();
@@ -335,6 +390,11 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectorySt
     EXPECT_TRUE(superseded) << "keyframe " << old.index;
   }
   EXPECT_EQ(retired, r.odometry.keyframes_retired);
+  // Their graph nodes were merged into the keyframes that stand for them where a loop tied the passes together.
+  std::printf("overlap: %zu graph nodes, %zu merged, %zu kept\n", r.graph_nodes, r.stats.merged, r.stats.unmerged);
+  EXPECT_EQ(r.stats.merged + r.stats.unmerged, retired);
+  EXPECT_GE(r.stats.merged, 1u);
+  EXPECT_EQ(r.graph_nodes, r.keyframes.size() - r.stats.merged);
 }
 
 }  // namespace

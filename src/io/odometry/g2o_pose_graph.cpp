@@ -71,7 +71,7 @@ G2oGraph toG2o(const backend::PoseGraph& graph) {
     g2o.vertices.push_back(G2oVertex{id, graph.pose(id), 0});
     if (graph.isFixed(id)) g2o.fixed.push_back(id);
   }
-  for (std::size_t i = 0; i < graph.edgeCount(); ++i) {
+  for (const std::size_t i : graph.edgeIndices()) {
     const backend::PoseGraphEdge& e = graph.edge(i);
     if (!e.enabled) continue;
     if (e.kind == backend::EdgeKind::kPrior)

@@ -24,6 +24,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("max_rotation_drift_floor", c.max_rotation_drift_floor)
       .bind("max_rotation_drift_ratio", c.max_rotation_drift_ratio)
       .bind("degenerate_rotation_drift", c.degenerate_rotation_drift)
+      .bind("keep_retired_nodes", c.keep_retired_nodes)
       .nested("scan_context",
               [&](YamlSection& n) {
                 n.bind("rings", d.rings)
