@@ -18,7 +18,8 @@
 // before the next sweep, as late as the loop thread would make it, reproducibly.
 // The ground truth of every lap (10 Hz, T_world_imu) goes to OUT_DIR/bench_memory_truth.tum, for drover eval ape
 // against bench_memory_imu_rate.tum.
-//   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay|delayed] [LOOP_HZ=1]
+//   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay|delayed] [LOOP_HZ=1] [CONFIG]
+// CONFIG: a platform file instead of config/farm_sim.yaml (to try a setting over the hour).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -52,8 +53,9 @@ long statusKb(const std::string& field) {
   return -1;
 }
 
-pipeline::OdometryConfig farmConfig() {  // the platform file drover run uses for the farm course
-  return io::loadOdometryConfig(std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml");
+// The platform file drover run uses for the farm course, unless another is given.
+pipeline::OdometryConfig farmConfig(const std::string& path) {
+  return io::loadOdometryConfig(path.empty() ? std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml" : path);
 }
 
 struct Lap {
@@ -266,6 +268,7 @@ int main(int argc, char** argv) {
   const std::string out_dir = argc > 3 ? argv[3] : "/tmp";
   const std::string mode = argc > 4 ? argv[4] : "live";
   const double loop_hz = argc > 5 ? std::stod(argv[5]) : 1.0;
+  const std::string config_path = argc > 6 ? argv[6] : "";
   if (mode != "live" && mode != "replay" && mode != "delayed") {
     std::fprintf(stderr, "MODE must be live, replay or delayed, not '%s'\n", mode.c_str());
     return 2;
@@ -281,11 +284,11 @@ int main(int argc, char** argv) {
 
   std::unique_ptr<Runner> runner;
   if (mode == "live") {
-    runner = std::make_unique<LiveRunner>(farmConfig(), calibration, loop_hz);
+    runner = std::make_unique<LiveRunner>(farmConfig(config_path), calibration, loop_hz);
   } else if (mode == "delayed") {
-    runner = std::make_unique<DelayedRunner>(farmConfig(), calibration, 1.0 / loop_hz);
+    runner = std::make_unique<DelayedRunner>(farmConfig(config_path), calibration, 1.0 / loop_hz);
   } else {
-    runner = std::make_unique<ReplayRunner>(farmConfig(), calibration);
+    runner = std::make_unique<ReplayRunner>(farmConfig(config_path), calibration);
   }
   Trajectory truth;
   runner->record.log.streamTo(out_dir + "/bench_memory_sweeps.jsonl");
