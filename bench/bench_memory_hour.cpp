@@ -174,46 +174,57 @@ class LiveRunner : public Runner {
   std::mutex record_mutex_;
 };
 
-class ReplayRunner : public Runner {
+// LidarOdometry fed in line (replay and delayed modes): what both count.
+class InlineRunner : public Runner {
  public:
-  ReplayRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration)
+  InlineRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration)
       : lis_(odometry, calibration) {
     lis_.setImuRateListener([this](const StampedPose& p) { record.imu_rate->add(p.t, p.T_world_body); });
   }
-  void push(Measurement&& m) override {
+  void finish() override {
+    for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
+  }
+
+ protected:
+  void process(const Measurement& m) {
     for (const pipeline::ScanOutcome& s : lis_.process(m)) {
       record.add(s);
       ++processed_;
     }
   }
-  void fill(Lap& row) override {
+  void fillFrom(const pipeline::LoopClosure& loops, Lap& row) {
     row.sweeps = processed_;
     row.loops = lis_.stats().loop_times.size();
     row.keyframes = lis_.stats().keyframes;
     row.kf_lis = lis_.keyframeBytes();
     row.retired = lis_.stats().keyframes_retired;
     row.cache = lis_.keyframeMap().cacheBytes();
-    row.descriptors = lis_.loopClosure().descriptorBytes();
-    loopCounts(lis_.loopClosure(), events_seen_, row);
-    events_seen_ = lis_.loopClosure().events().size();
+    row.descriptors = loops.descriptorBytes();
+    loopCounts(loops, events_seen_, row);
+    events_seen_ = loops.events().size();
   }
-  void finish() override {
-    for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
-  }
-  const pipeline::LoopClosure* loops() const override { return &lis_.loopClosure(); }
+  pipeline::LidarOdometry lis_;
 
  private:
-  pipeline::LidarOdometry lis_;
   std::size_t processed_ = 0, events_seen_ = 0;
+};
+
+class ReplayRunner : public InlineRunner {
+ public:
+  using InlineRunner::InlineRunner;
+  void push(Measurement&& m) override { process(m); }
+  void fill(Lap& row) override { fillFrom(lis_.loopClosure(), row); }
+  const pipeline::LoopClosure* loops() const override { return &lis_.loopClosure(); }
 };
 
 // LidarOdometry with its loop closure outside, in line: keyframes searched by a LoopWorker in batches every
 // `period` of data time, corrections applied before the next sweep.
-class DelayedRunner : public Runner {
+class DelayedRunner : public InlineRunner {
  public:
   DelayedRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration, double period_s)
-      : lis_(odometry, calibration), worker_(odometry.loop, odometry.local_map), period_(fromSeconds(period_s)) {
-    lis_.setImuRateListener([this](const StampedPose& p) { record.imu_rate->add(p.t, p.T_world_body); });
+      : InlineRunner(odometry, calibration),
+        worker_(odometry.loop, odometry.local_map),
+        period_(fromSeconds(period_s)) {
     lis_.setKeyframeListener([this](const pipeline::KeyframeRecord& k) { pending_.push_back(k); }, true);
   }
   void push(Measurement&& m) override {
@@ -229,35 +240,19 @@ class DelayedRunner : public Runner {
         correction_.reset();
       }
     }
-    for (const pipeline::ScanOutcome& s : lis_.process(m)) {
-      record.add(s);
-      ++processed_;
-    }
+    process(m);
   }
   void fill(Lap& row) override {
-    row.sweeps = processed_;
-    row.loops = lis_.stats().loop_times.size();
-    row.keyframes = lis_.stats().keyframes;
-    row.kf_lis = lis_.keyframeBytes();
+    fillFrom(worker_.loopClosure(), row);
     row.kf_loop = worker_.keyframeBytes();
-    row.retired = lis_.stats().keyframes_retired;
-    row.cache = lis_.keyframeMap().cacheBytes();
-    row.descriptors = worker_.loopClosure().descriptorBytes();
-    loopCounts(worker_.loopClosure(), events_seen_, row);
-    events_seen_ = worker_.loopClosure().events().size();
-  }
-  void finish() override {
-    for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
   }
   const pipeline::LoopClosure* loops() const override { return &worker_.loopClosure(); }
 
  private:
-  pipeline::LidarOdometry lis_;
   pipeline::LoopWorker worker_;
   Time period_ = 0, next_batch_ = 0;
   std::vector<pipeline::KeyframeRecord> pending_;
   std::optional<pipeline::LoopCorrection> correction_;
-  std::size_t processed_ = 0, events_seen_ = 0;
 };
 
 }  // namespace
@@ -306,7 +301,8 @@ int main(int argc, char** argv) {
     // Each lap its own noise (seed + lap); the same world and path: the robot drives the same course again.
     const sim::Simulator simulator(scenario, sc, seed + static_cast<unsigned>(lap) * 1000);
     const Trajectory lap_truth = simulator.groundTruth();
-    for (std::size_t i = 0; i < lap_truth.size(); i += 20) truth.push_back({lap_truth[i].t + offset, lap_truth[i].T_world_body});
+    for (std::size_t i = 0; i < lap_truth.size(); i += 20)
+      truth.push_back({lap_truth[i].t + offset, lap_truth[i].T_world_body});
     simulator.run([&](Measurement&& m) {
       if (auto* imu = std::get_if<ImuSample>(&m)) {
         imu->t += offset;
@@ -336,7 +332,8 @@ int main(int argc, char** argv) {
   }
   runner->finish();
   io::writeTum(out_dir + "/bench_memory_truth.tum", truth);
-  if (const pipeline::LoopClosure* loops = runner->loops()) writeLoopEvents(*loops, out_dir + "/bench_memory_loops.csv");
+  if (const pipeline::LoopClosure* loops = runner->loops())
+    writeLoopEvents(*loops, out_dir + "/bench_memory_loops.csv");
   const Lap& first = rows.front();
   const Lap& last = rows.back();
   const auto mb = [](double kb) { return kb / 1024.0; };

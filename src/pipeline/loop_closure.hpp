@@ -122,8 +122,8 @@ class LoopClosure {
   // joins the two places (a loop between keyframes within submap_keyframes of each), its graph node is merged into
   // `by`'s (PoseGraph::mergeNode): their relative pose at the current estimate is held rigid from now on and
   // poses() gives it as `by`'s pose times that. So the graph, like the map, grows with the area driven, not the
-  // time (with keep_retired_nodes, or without such a loop, the node stays free). Call after retiring it in the map given to
-  // addKeyframe. Throws std::invalid_argument for an unknown index or by <= index.
+  // time (with keep_retired_nodes, or without such a loop, the node stays free). Call after retiring it in the map
+  // given to addKeyframe. Throws std::invalid_argument for an unknown index or by <= index.
   void retire(std::size_t index, std::size_t by);
   std::size_t graphNodes() const;  // nodes in the pose graph (keyframes less the merged ones)
   std::size_t descriptorBytes() const;  // [bytes] the database's stored descriptors

@@ -12,6 +12,7 @@
 
 #include "geometry/se3.hpp"
 #include "geometry/so3.hpp"
+#include "pose_graph_test_util.hpp"
 
 namespace drover::backend {
 namespace {
@@ -33,13 +34,7 @@ std::vector<Eigen::Isometry3d> helix(int n) {
   return poses;
 }
 
-Vector6d randomTangent(std::mt19937& rng, double sigma_position, double sigma_rotation) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Vector6d xi;
-  for (int i = 0; i < 3; ++i) xi(i) = sigma_position * n(rng);
-  for (int i = 3; i < 6; ++i) xi(i) = sigma_rotation * n(rng);
-  return xi;
-}
+using test::randomTangent;
 
 Matrix6d information(double sigma_position, double sigma_rotation) {
   Vector6d d;

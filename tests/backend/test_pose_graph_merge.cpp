@@ -13,6 +13,7 @@
 #include "backend/pose_graph_merge.hpp"
 #include "geometry/se3.hpp"
 #include "geometry/so3.hpp"
+#include "pose_graph_test_util.hpp"
 
 namespace drover::backend {
 namespace {
@@ -20,13 +21,7 @@ namespace {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 using geometry::expSE3;
 
-Vector6d randomTangent(std::mt19937& rng, double sigma_position, double sigma_rotation) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Vector6d xi;
-  for (int i = 0; i < 3; ++i) xi(i) = sigma_position * n(rng);
-  for (int i = 3; i < 6; ++i) xi(i) = sigma_rotation * n(rng);
-  return xi;
-}
+using test::randomTangent;
 
 Eigen::Isometry3d randomPose(std::mt19937& rng) { return expSE3(randomTangent(rng, 5.0, 1.0)); }
 
@@ -80,7 +75,8 @@ TEST(PoseGraphMerge, MovingTheToEndOfAnEdgeOrAPriorKeepsItsCostToFirstOrderInThe
       const Eigen::Isometry3d truth = kind == EdgeKind::kPrior ? T_id : T_from.inverse() * T_id;
       const int from = kind == EdgeKind::kPrior ? 2 : 1;
       // A residual of a centimetre and 10 mrad: the neglected term is |r_phi| |t_x| ~ 1 % of |r|.
-      const PoseGraphEdge e{from, 2, truth * expSE3(randomTangent(rng, 0.01, 0.01)), randomInformation(rng), kind, true};
+      const PoseGraphEdge e{from, 2, truth * expSE3(randomTangent(rng, 0.01, 0.01)), randomInformation(rng), kind,
+                            true};
       const PoseGraphEdge moved = moveToEnd(e, 7, T_id_into);
       EXPECT_EQ(moved.to, 7);
       EXPECT_EQ(moved.from, kind == EdgeKind::kPrior ? 7 : 1);
