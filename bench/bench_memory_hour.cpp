@@ -23,6 +23,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -95,14 +96,21 @@ void loopCounts(const pipeline::LoopClosure& loops, std::size_t first_event, Lap
 // Every verified loop (replay and delayed modes), one line each, to follow the loop closure lap by lap.
 void writeLoopEvents(const pipeline::LoopClosure& loops, const std::string& path) {
   std::ofstream out(path);
-  out << "t_query_s,query,candidate,source,accepted,implied_drift_m,drift_budget_m,implied_rotation_deg,"
-         "rotation_budget_deg,correction_m,graph_iterations,reason\n";
-  for (const pipeline::LoopEvent& e : loops.events())
-    out << fmt::format("{:.2f},{},{},{},{},{:.3f},{:.3f},{:.2f},{:.2f},{:.3f},{},\"{}\"\n", toSeconds(e.t_query),
-                       e.query, e.candidate, e.source, e.verification.accepted ? 1 : 0, e.implied_drift,
-                       e.drift_budget, e.implied_rotation * 180 / std::numbers::pi,
-                       e.rotation_budget * 180 / std::numbers::pi, e.correction, e.graph_iterations,
-                       e.verification.reason);
+  // The measured relative pose (query in the candidate's lidar frame: x, y, z [m], yaw [deg]) so that a loop can be
+  // judged against the ground truth at t_candidate_s and t_query_s.
+  out << "t_query_s,t_candidate_s,query,candidate,source,accepted,implied_drift_m,drift_budget_m,implied_rotation_deg,"
+         "rotation_budget_deg,correction_m,graph_iterations,x_m,y_m,z_m,yaw_deg,reason\n";
+  for (const pipeline::LoopEvent& e : loops.events()) {
+    const Eigen::Isometry3d& T = e.verification.T_candidate_query;
+    const double yaw = std::atan2(T.linear()(1, 0), T.linear()(0, 0)) * 180 / std::numbers::pi;
+    out << fmt::format("{:.2f},{:.2f},{},{},{},{},{:.3f},{:.3f},{:.2f},{:.2f},{:.3f},{},{:.3f},{:.3f},{:.3f},{:.2f},"
+                       "\"{}\"\n",
+                       toSeconds(e.t_query), toSeconds(e.t_candidate), e.query, e.candidate, e.source,
+                       e.verification.accepted ? 1 : 0, e.implied_drift, e.drift_budget,
+                       e.implied_rotation * 180 / std::numbers::pi, e.rotation_budget * 180 / std::numbers::pi,
+                       e.correction, e.graph_iterations, T.translation().x(), T.translation().y(),
+                       T.translation().z(), yaw, e.verification.reason);
+  }
 }
 
 // The System (live threads) or LidarOdometry (replay, in line) fed measurement by measurement.
