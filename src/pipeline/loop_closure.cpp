@@ -81,6 +81,12 @@ struct LoopClosure::Impl {
   std::vector<Merged> merged;
   std::vector<std::pair<std::size_t, std::size_t>> accepted_loops;  // (candidate, query) keyframe indices
 
+  // The odometry reported a degenerate direction (or a failed match) between keyframes i - 2 and i + 2.
+  bool degeneratePlace(std::size_t i) const {
+    const std::size_t a = i >= 2 ? i - 2 : 0, b = std::min(i + 2, degenerate_before.size() - 1);
+    return degenerate_before[b] > degenerate_before[a];
+  }
+
   // An accepted loop joins the neighbourhoods (+-submap_keyframes) of keyframes `older` and `newer`.
   bool loopBetween(std::size_t older, std::size_t newer) const {
     const auto near = [&](std::size_t a, std::size_t b) {
@@ -149,6 +155,8 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   bool closed = false;
   if (m.skip > 0) {
     --m.skip;
+  } else if (m.config.skip_degenerate_places && m.degeneratePlace(index)) {
+    ++m.stats.degenerate_places;
   } else {
     ++m.stats.queries;
     m.searched[index] = true;
@@ -201,6 +209,10 @@ std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map,
     if (std::optional<Candidate> r = radiusCandidate(map, index)) out.push_back(*r);
   std::vector<Candidate> unique;
   for (const Candidate& c : out) {
+    if (config.skip_degenerate_places && degeneratePlace(c.index)) {
+      ++stats.degenerate_places;
+      continue;
+    }
     const bool seen = std::any_of(unique.begin(), unique.end(), [&](const Candidate& u) { return u.index == c.index; });
     if (!seen && static_cast<int>(unique.size()) < config.max_verifications) unique.push_back(c);
   }

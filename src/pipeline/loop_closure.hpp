@@ -61,6 +61,13 @@ struct LoopClosureConfig {
   // Retired keyframes keep their own graph node (LIO-SAM: the graph grows with time). Off by default: a retired
   // keyframe's node is merged into the newer keyframe that stands for its place (see retire()).
   bool keep_retired_nodes = false;
+  // No loop where the odometry was degenerate within 2 keyframes of the query or the candidate (a featureless
+  // corridor): there the scan match cannot fix the offset along the corridor and the candidate's own pose is what
+  // loosened odometry edges left it, tens of metres off on the farm course; such loops pulled a good estimate 26 m
+  // and 7 deg away on its third lap. Off by default: over the farm hour it kept the heading within 4 deg for two
+  // laps more, but the corridor's passes then never coincide, so its keyframes never retire (peak +16 % by lap 3),
+  // and an 18 deg jump still came in lap 3 (bench/RESULTS.md).
+  bool skip_degenerate_places = false;
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };
@@ -93,6 +100,7 @@ struct LoopStats {
   std::size_t retired = 0;                           // keyframes retired (retire()): no longer candidates
   std::size_t merged = 0;                            // of them, graph nodes merged into a newer keyframe's
   std::size_t unmerged = 0;                          // of them, kept as nodes: no accepted loop linked the places
+  std::size_t degenerate_places = 0;                 // queries not searched and candidates dropped: degenerate there
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
 };
 

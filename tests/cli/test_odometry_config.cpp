@@ -400,6 +400,7 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   max_rotation_drift_ratio: 0.001
   degenerate_rotation_drift: 0.02
   keep_retired_nodes: true
+  skip_degenerate_places: true
   scan_context:
     sensor_height: 1.5
     auto_height: true
@@ -425,6 +426,7 @@ odometry:
   EXPECT_EQ(c.loop.max_rotation_drift_ratio, 0.001);
   EXPECT_EQ(c.loop.degenerate_rotation_drift, 0.02);
   EXPECT_TRUE(c.loop.keep_retired_nodes);
+  EXPECT_TRUE(c.loop.skip_degenerate_places);
   EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
   EXPECT_TRUE(c.loop.database.descriptor.auto_height);
   EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);

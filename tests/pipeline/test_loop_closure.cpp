@@ -148,7 +148,9 @@ TEST(LoopClosure, ALoopThatWouldTurnTheQueryBeyondTheRotationBudgetIsRejectedAnd
   // not at all (a degenerate translation says nothing about the heading), and the loops are still refused.
   geometry::Matrix6d along_x = geometry::Matrix6d::Zero();
   along_x(0, 0) = 1.0;
-  const auto corridor = lapWithAHeadingError(courtyardConfig(), along_x);
+  LoopClosureConfig searched = courtyardConfig();
+  searched.skip_degenerate_places = false;  // the default, said: the budgets are what is tested here
+  const auto corridor = lapWithAHeadingError(searched, along_x);
   EXPECT_EQ(corridor->stats().accepted, 0u);
   int in_corridor = 0;
   for (const LoopEvent& e : corridor->events()) {
@@ -181,6 +183,35 @@ std::unique_ptr<LoopClosure> exactLap(const LoopClosureConfig& c, VisualYawPrior
     }
   }
   return loops;
+}
+
+// The lap of exactLap, but the odometry reported a degenerate direction (along x) on its first 5 keyframes: the
+// returns to the start find candidates only there, and they are not loops to trust.
+TEST(LoopClosure, AskedToSkipDegeneratePlacesItClosesNoLoopWhereTheOdometryWasDegenerate) {
+  for (const bool skip : {true, false}) {
+    LoopClosureConfig c = courtyardConfig();
+    c.skip_degenerate_places = skip;
+    LoopClosure loops(c);
+    lidar::LocalMap map;
+    for (int i = 0; i <= 40; ++i) {
+      lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
+      f.t = fromSeconds(i);
+      geometry::Matrix6d degenerate = geometry::Matrix6d::Zero();
+      if (i >= 1 && i <= 4) degenerate(0, 0) = 1.0;
+      if (loops.addKeyframe(map, map.addKeyframe(f, lapPose(i)), degenerate)) {
+        const std::vector<Eigen::Isometry3d> poses = loops.poses();
+        for (std::size_t k = 0; k < poses.size(); ++k) map.updatePose(k, poses[k]);
+      }
+    }
+    if (skip) {
+      EXPECT_EQ(loops.stats().accepted, 0u);
+      EXPECT_GE(loops.stats().degenerate_places, 1u);
+      for (const LoopEvent& e : loops.events()) EXPECT_GE(e.candidate, 6u) << "2 keyframes clear of the stretch";
+    } else {
+      EXPECT_GE(loops.stats().accepted, 1u) << "the same lap closes when degenerate places are searched";
+      EXPECT_EQ(loops.stats().degenerate_places, 0u);
+    }
+  }
 }
 
 TEST(LoopClosure, TheRadiusSourceFindsTheStartAgainFromTheEstimateAlone) {

@@ -25,6 +25,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("max_rotation_drift_ratio", c.max_rotation_drift_ratio)
       .bind("degenerate_rotation_drift", c.degenerate_rotation_drift)
       .bind("keep_retired_nodes", c.keep_retired_nodes)
+      .bind("skip_degenerate_places", c.skip_degenerate_places)
       .nested("scan_context",
               [&](YamlSection& n) {
                 n.bind("rings", d.rings)
