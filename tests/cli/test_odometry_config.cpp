@@ -8,6 +8,7 @@
 
 #include "io/error.hpp"
 #include "io/odometry/odometry_config_io.hpp"
+#include "odometry_config_test_util.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
@@ -15,27 +16,10 @@ namespace {
 
 using pipeline::OdometryConfig;
 
-std::string shipped(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
-
-bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-// Writes `text` to a fresh file in `dir` and loads it.
-OdometryConfig load(const test::TempDir& dir, const std::string& text) {
-  const auto path = dir / "odometry.yaml";
-  test::writeText(path, text);
-  return loadOdometryConfig(path.string());
-}
-
-// The IoError message of loading `text` (a failed expectation when it loads).
-std::string errorOf(const test::TempDir& dir, const std::string& text) {
-  try {
-    load(dir, text);
-  } catch (const IoError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "expected an IoError for:\n" << text;
-  return {};
-}
+using test_config::errorOf;
+using test_config::has;
+using test_config::load;
+using test_config::shipped;
 
 TEST(OdometryConfigReader, EveryShippedConfigLoadsAndPassesValidation) {
   for (const char* name :
@@ -387,67 +371,6 @@ TEST(OdometryConfigReader, InvalidYamlIsAnErrorNamingFileAndLine) {
   test::TempDir dir;
   const std::string e = errorOf(dir, "odometry:\n  use_imu: true\n  layout: [16\n");
   EXPECT_TRUE(has(e, (dir / "odometry.yaml").string()) && has(e, "invalid YAML") && has(e, "line ")) << e;
-}
-
-TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
-  test::TempDir dir;
-  const OdometryConfig c = load(dir, R"(loop:
-  enabled: false
-  source: both
-  min_age: 12.5
-  max_drift_ratio: 0.2
-  max_rotation_drift_floor: 0.3
-  max_rotation_drift_ratio: 0.001
-  degenerate_rotation_drift: 0.02
-  keep_retired_nodes: true
-  skip_degenerate_places: true
-  scan_context:
-    sensor_height: 1.5
-    auto_height: true
-    threshold: 0.2
-    search_radius: 4
-    candidates: 7
-    exclude_recent: 20
-  verifier:
-    max_fitness: 0.3
-    min_inliers: 50
-  graph:
-    loop_loss: cauchy
-    loop_loss_scale: 2.0
-odometry:
-  matcher:
-    max_iterations: 17
-)");
-  EXPECT_FALSE(c.loop.enabled);
-  EXPECT_EQ(c.loop.source, pipeline::LoopSource::kBoth);
-  EXPECT_EQ(c.loop.min_age, 12.5);
-  EXPECT_EQ(c.loop.max_drift_ratio, 0.2);
-  EXPECT_EQ(c.loop.max_rotation_drift_floor, 0.3);
-  EXPECT_EQ(c.loop.max_rotation_drift_ratio, 0.001);
-  EXPECT_EQ(c.loop.degenerate_rotation_drift, 0.02);
-  EXPECT_TRUE(c.loop.keep_retired_nodes);
-  EXPECT_TRUE(c.loop.skip_degenerate_places);
-  EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
-  EXPECT_TRUE(c.loop.database.descriptor.auto_height);
-  EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);
-  EXPECT_EQ(c.loop.database.descriptor.search_radius, 4);
-  EXPECT_EQ(c.loop.database.candidates, 7);
-  EXPECT_EQ(c.loop.database.exclude_recent, 20);
-  EXPECT_EQ(c.loop.verifier.max_fitness, 0.3);
-  EXPECT_EQ(c.loop.verifier.min_inliers, 50);
-  EXPECT_EQ(c.loop.graph.loop_loss, backend::RobustLoss::kCauchy);
-  EXPECT_EQ(c.loop.graph.loop_loss_scale, 2.0);
-  EXPECT_EQ(c.loop.verifier.matcher.max_iterations, 17);  // the verifier matches as the odometry does
-}
-
-TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {
-  test::TempDir dir;
-  std::string e = errorOf(dir, "loop:\n  scan_context:\n    rings: 20\n    ring: 20\n");
-  EXPECT_TRUE(has(e, "line 4") && has(e, "loop.scan_context.ring")) << e;
-  e = errorOf(dir, "loop:\n  source: scan-context\n");
-  EXPECT_TRUE(has(e, "line 2") && has(e, "loop.source") && has(e, "scancontext")) << e;
-  e = errorOf(dir, "loop:\n  scan_context:\n    threshold: 5\n");
-  EXPECT_TRUE(has(e, "threshold")) << e;
 }
 
 }  // namespace
