@@ -79,9 +79,14 @@ void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
                    : "moving start (" + r.reason + "): attitude from the mean specific force, velocity 0";
 }
 
-void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias) {
+void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias,
+                        const std::optional<Eigen::Matrix3d>& gyro_bias_covariance) {
   smoother_.reset();
-  smoother_.initialize(state, bias, config_.preintegration);
+  if (gyro_bias_covariance) {
+    smoother_.initialize(state, bias, config_.preintegration, *gyro_bias_covariance);
+  } else {
+    smoother_.initialize(state, bias, config_.preintegration);
+  }
   propagator_.reset(state, bias);
 }
 
@@ -97,16 +102,9 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
   if (!initialized_ || !smoother_.initialized()) return;
   const std::optional<Eigen::Matrix3d> gyro_covariance = smoother_.gyroBiasCovariance();
   imu::NavState state = smoother_.state();
-  const imu::ImuBias bias = smoother_.bias();
   state.T_world_imu = T_new_old * state.T_world_imu;
   state.v_world = T_new_old.linear() * state.v_world;
-  if (!gyro_covariance) {
-    restart(state, bias);
-    return;
-  }
-  smoother_.reset();
-  smoother_.initialize(state, bias, config_.preintegration, *gyro_covariance);
-  propagator_.reset(state, bias);
+  restart(state, smoother_.bias(), gyro_covariance);
 }
 
 std::optional<imu::FusedState> ImuFusion::fusedState() const {

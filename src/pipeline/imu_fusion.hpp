@@ -64,7 +64,10 @@ class ImuFusion {
   std::optional<imu::FusedState> fusedState() const;
 
  private:
-  void restart(const imu::NavState& state, const imu::ImuBias& bias);
+  // Smoother and propagation from `state`, under the config's first-state prior; the gyro bias's under the given
+  // covariance [(rad/s)^2] when there is one.
+  void restart(const imu::NavState& state, const imu::ImuBias& bias,
+               const std::optional<Eigen::Matrix3d>& gyro_bias_covariance = std::nullopt);
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
 
   OdometryConfig config_;
