@@ -33,6 +33,7 @@ struct RunOptions {
   std::string dataset, format, config, out;
   bool no_imu = false, no_camera = false, no_lidar = false, no_loop = false, quiet = false, realtime = false;
   double start = 0, duration = 0;  // [s] from the first measurement; duration 0 = to the end
+  double rate = 1.0;               // [-] --realtime: sensor seconds per wall second
   std::size_t max_frames = 0;      // KITTI odometry: first N frames only
 };
 
@@ -80,6 +81,9 @@ void checkOptions(const RunOptions& o) {
   if (o.realtime && o.no_lidar)
     throw std::invalid_argument("--realtime with --no-lidar: the real-time replay runs the LIS and loop closure; the "
                                 "VIS alone runs in the deterministic replay (drop --realtime)");
+  if (o.rate != 1.0 && !o.realtime)
+    throw std::invalid_argument("--rate sets the speed of the --realtime replay; without --realtime the run goes as "
+                                "fast as the computer allows");
   io::StagedFolder::check(o.out, runFolderRules());  // before any work: a foreign or unusable --out costs nothing
 }
 
@@ -160,7 +164,7 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   pipeline::SystemConfig system_config;
   system_config.odometry = config;
   if (!o.config.empty()) system_config.live = io::loadLiveConfig(o.config);
-  RealtimeOptions options{o.start, o.duration, nullptr, nullptr};
+  RealtimeOptions options{o.start, o.duration, o.rate, nullptr, nullptr};
   std::unique_ptr<RunVis> vis;  // with images, an IMU and usable intrinsics: the VIS in its own thread
   const bool camera = visual::validateIntrinsics(reader.calibration().camera).empty();
   if (camera && !o.no_camera && !o.no_imu && o.format != "kitti") {
@@ -327,6 +331,8 @@ void registerRun(CLI::App& app) {
   cmd->add_flag("--realtime", o->realtime,
                 "Replay at sensor rate through the live system (threads, bounded queues: a slow stage drops sweeps); "
                 "report.json gains latency per output and the sweeps dropped");
+  addNumber(cmd, "--rate", o->rate, between(0.01, 100, "x"),
+            "With --realtime: play the data R times as fast as recorded (0.5: half speed, as rosbag play -r)");
   cmd->add_flag("-q,--quiet", o->quiet, "Only print errors");
   cmd->callback([o] { runOdometry(*o); });
 }

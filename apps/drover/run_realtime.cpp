@@ -161,7 +161,8 @@ void runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const
         data_zero = arrival;
         wall_zero = Clock::now();
       }
-      const Clock::time_point due = wall_zero + std::chrono::nanoseconds(arrival - *data_zero);
+      const auto since = std::chrono::nanoseconds(static_cast<Time>(static_cast<double>(arrival - *data_zero) / o.rate));
+      const Clock::time_point due = wall_zero + since;
       std::this_thread::sleep_until(due);
       late_ms_max = std::max(late_ms_max, msBetween(due, Clock::now()));
       if (auto* imu = std::get_if<ImuSample>(&m)) {
@@ -204,6 +205,7 @@ void runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const
   const pipeline::SystemStats s = system.stats();
   if (o.vis != nullptr) o.vis->attach(system.vis(), s.frames_pushed, s.frames_bad);
   run.realtime = Json{{"latency_ms", {{"sweep", lat.sweep_ms.percentiles()}, {"imu_rate", lat.imu_ms.percentiles()}}},
+                      {"rate", o.rate},
                       {"first_sweep_ms", lat.first_sweep_ms},
                       {"startup_sweeps", lat.startup_sweeps},
                       {"sweeps_dropped", s.sweeps_dropped},

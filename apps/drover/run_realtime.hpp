@@ -18,6 +18,7 @@ namespace drover::cli {
 
 struct RealtimeOptions {
   double start = 0, duration = 0;  // [s] as drover run's --start / --duration (duration 0 = to the end)
+  double rate = 1.0;  // [-] sensor seconds played per wall second (--rate; 0.5: half speed)
   std::shared_ptr<visual::KeypointDetector> detector;  // the VIS's, with config.vis
   RunVis* vis = nullptr;  // records the VIS's frames (with config.vis)
 };

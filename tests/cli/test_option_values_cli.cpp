@@ -74,6 +74,7 @@ std::vector<NumericOption> everyNumericOption() {
       {run, "--start", seconds},
       {run, "--duration", seconds},
       {run, "--max-frames", count},
+      {run, "--rate", {"nan", "0", "-1", "inf", "1e3"}},
       {sim, "--seed", {"-1", kTwo64, kTwo70, "1.5", "nan"}},
       {sim, "--duration", {"nan", "-1", "1e9", "1e12", "inf"}},
       {sim, "--camera-rate", {"0", "-15", "nan", "inf", "1e9"}},

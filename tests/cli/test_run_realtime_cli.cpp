@@ -32,7 +32,8 @@ std::string deepQueueConfig(const TempDir& dir) {
   return (dir / "platform.yaml").string();
 }
 
-// 6 s of sharp-turns without a camera (2.5 s at rest, then 4 m straight), at sensor rate and as a replay.
+// 6 s of sharp-turns without a camera (2.5 s at rest, then 4 m straight), at three times sensor rate (--rate 3, as
+// rosbag play -r 3) and as a replay.
 TEST(RunRealtime, WritesTheReplaysFilesWithLatencyPerOutputAndDropsNothingOnALightCourse) {
   TempDir dir;
   const CliResult sim =
@@ -40,7 +41,7 @@ TEST(RunRealtime, WritesTheReplaysFilesWithLatencyPerOutputAndDropsNothingOnALig
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   const std::string run =
       "run " + (dir / "course").string() + " --format sim --config " + deepQueueConfig(dir) + " --no-loop";
-  const CliResult live = runDrover(run + " --realtime --out " + (dir / "live").string());
+  const CliResult live = runDrover(run + " --realtime --rate 3 --out " + (dir / "live").string());
   ASSERT_EQ(live.exit_code, 0) << live.output;
   EXPECT_TRUE(contains(live.output, "realtime: latency sweep end -> pose")) << live.output;
   const CliResult replay = runDrover(run + " -q --out " + (dir / "replay").string());
@@ -58,8 +59,10 @@ TEST(RunRealtime, WritesTheReplaysFilesWithLatencyPerOutputAndDropsNothingOnALig
   // The IMU-rate pose is propagated on the pushing thread: well under a millisecond typically, 2 ms asked.
   EXPECT_LT(rt["latency_ms"]["imu_rate"]["p50"].get<double>(), 2.0);
   EXPECT_GT(rt["latency_ms"]["imu_rate"]["count"].get<int>(), 600);  // 200 Hz once initialised
-  // At sensor rate the run takes as long as the data (the replay takes a fraction of it).
-  EXPECT_GT(r["wall_s"].get<double>(), 5.0);
+  // Paced: the run takes as long as the data played three times as fast (the replay takes a fraction of it).
+  EXPECT_EQ(rt["rate"].get<double>(), 3.0);
+  EXPECT_GT(r["wall_s"].get<double>(), 6.0 / 3 - 0.2);
+  EXPECT_LT(r["wall_s"].get<double>(), 4.5);
   const Json p = readJson(dir / "replay" / "report.json");
   EXPECT_FALSE(p.contains("realtime"));
   EXPECT_EQ(r["counts"]["scans_processed"], p["counts"]["scans_processed"]);
@@ -69,6 +72,15 @@ TEST(RunRealtime, WritesTheReplaysFilesWithLatencyPerOutputAndDropsNothingOnALig
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i)
     EXPECT_LT((a[i].T_world_body.translation() - b[i].T_world_body.translation()).norm(), 1e-6) << i;
+}
+
+TEST(RunRealtime, ARateWithoutRealtimeIsRefusedBeforeAnyWork) {
+  TempDir dir;
+  const CliResult r =
+      runDrover("run " + dir.path().string() + " --format sim --rate 0.5 --out " + (dir / "out").string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_TRUE(contains(r.output, "--rate sets the speed of the --realtime replay")) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(RunRealtime, WithNoLidarItIsRefusedBeforeAnyWork) {
