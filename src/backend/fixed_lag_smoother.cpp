@@ -103,20 +103,44 @@ void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias
   impl_->initialized = true;
 }
 
+namespace {
+
+// U with U^T U = C^-1 for a finite, symmetric, positive definite C; nothing otherwise.
+template <int N>
+std::optional<Eigen::Matrix<double, N, N>> sqrtInformation(const Eigen::Matrix<double, N, N>& C) {
+  using Matrix = Eigen::Matrix<double, N, N>;
+  if (!C.allFinite() || (C - C.transpose()).norm() > 1e-9 * C.norm()) return std::nullopt;
+  const Eigen::LLT<Matrix> information(Matrix(0.5 * (C + C.transpose())).inverse());
+  if (information.info() != Eigen::Success) return std::nullopt;
+  const Matrix U = information.matrixU().toDenseMatrix();
+  if (!U.allFinite()) return std::nullopt;
+  return U;
+}
+
+}  // namespace
+
 void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias& bias,
                                   const imu::PreintegrationConfig& imu, const Eigen::Matrix3d& gyro_bias_covariance) {
-  const Eigen::Matrix3d& C = gyro_bias_covariance;
-  const Eigen::LLT<Eigen::Matrix3d> information((0.5 * (C + C.transpose())).inverse());
-  if (!C.allFinite() || (C - C.transpose()).norm() > 1e-9 * C.norm() || information.info() != Eigen::Success ||
-      !information.matrixU().toDenseMatrix().allFinite())
+  const std::optional<Eigen::Matrix3d> U = sqrtInformation<3>(gyro_bias_covariance);
+  if (!U)
     throw std::invalid_argument("FixedLagSmoother::initialize: the gyro bias covariance is not finite, symmetric "
                                 "and positive definite");
   initialize(state, bias, imu);
-  Matrix15d& L = impl_->window.prior.sqrt_information;  // r = L dx: the gyro bias rows are 9..11
-  L.block<3, 3>(9, 9) = information.matrixU();
+  impl_->window.prior.sqrt_information.block<3, 3>(9, 9) = *U;  // r = L dx: the gyro bias rows are 9..11
 }
 
-std::optional<Eigen::Matrix3d> FixedLagSmoother::gyroBiasCovariance() const {
+void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias& bias,
+                                  const imu::PreintegrationConfig& imu,
+                                  const Eigen::Matrix<double, 6, 6>& bias_covariance) {
+  const std::optional<Eigen::Matrix<double, 6, 6>> U = sqrtInformation<6>(bias_covariance);
+  if (!U)
+    throw std::invalid_argument("FixedLagSmoother::initialize: the bias covariance is not finite, symmetric and "
+                                "positive definite");
+  initialize(state, bias, imu);
+  impl_->window.prior.sqrt_information.block<6, 6>(9, 9) = *U;  // gyro rows 9..11, accelerometer 12..14
+}
+
+std::optional<Eigen::Matrix<double, 6, 6>> FixedLagSmoother::biasCovariance() const {
   if (!impl_->initialized) return std::nullopt;
   SmootherWindow window = impl_->window;  // the problem points into the nodes: a copy keeps this const
   RightQuaternionManifold manifold;
@@ -132,7 +156,13 @@ std::optional<Eigen::Matrix3d> FixedLagSmoother::gyroBiasCovariance() const {
   if (!covariance.Compute(blocks, &problem)) return std::nullopt;
   Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
   if (!covariance.GetCovarianceBlock(b, b, C.data()) || !C.allFinite()) return std::nullopt;
-  return Eigen::Matrix3d(C.topLeftCorner<3, 3>());
+  return Eigen::Matrix<double, 6, 6>(C);
+}
+
+std::optional<Eigen::Matrix3d> FixedLagSmoother::gyroBiasCovariance() const {
+  const std::optional<Eigen::Matrix<double, 6, 6>> C = biasCovariance();
+  if (!C) return std::nullopt;
+  return Eigen::Matrix3d(C->topLeftCorner<3, 3>());
 }
 
 SmootherUpdate FixedLagSmoother::update(const imu::Preintegrator& pim, const Eigen::Isometry3d& T_world_imu_measured) {

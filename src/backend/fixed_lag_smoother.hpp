@@ -73,6 +73,11 @@ class FixedLagSmoother {
   // covariance of the window's problem at the current estimate). Nothing when not initialized or when the
   // covariance cannot be computed.
   std::optional<Eigen::Matrix3d> gyroBiasCovariance() const;
+  // The same for both biases, [gyro (rad/s); acc (m/s^2)] (6x6), and a restart with that prior on both: for a
+  // restart after a correction that turned the world about gravity only, which changes neither bias.
+  std::optional<Eigen::Matrix<double, 6, 6>> biasCovariance() const;
+  void initialize(const imu::NavState& state, const imu::ImuBias& bias, const imu::PreintegrationConfig& imu,
+                  const Eigen::Matrix<double, 6, 6>& bias_covariance);
 
   // Adds state j at t_j = state().t + fromSeconds(pim.deltaTime()) (the time predict() gives), linked to the
   // newest state by the IMU factor of `pim` (integrated from state().t, at any linearisation bias) and the bias

@@ -109,6 +109,7 @@ void setLinearSolver(const PoseGraphConfig& config, ceres::Solver::Options& opti
 struct PoseGraph::Impl {
   Config config;
   RightQuaternionManifold manifold;
+  WorldYawManifold yaw_manifold;
   std::unique_ptr<ceres::LossFunction> loop_loss;
   std::map<int, NodeBlock> nodes;  // std::map: block addresses stay put as nodes are added
   std::map<std::size_t, EdgeEntry> edges;  // by index; a map so that merged edges can leave
@@ -197,7 +198,9 @@ void PoseGraph::addNode(int id, const Eigen::Isometry3d& T_world_node) {
   NodeBlock& n = impl_->nodes[id];
   n.set(T_world_node);
   impl_->problem.AddParameterBlock(n.p, 3);
-  impl_->problem.AddParameterBlock(n.q, 4, &impl_->manifold);
+  ceres::Manifold* rotation = impl_->config.yaw_only_rotation ? static_cast<ceres::Manifold*>(&impl_->yaw_manifold)
+                                                               : static_cast<ceres::Manifold*>(&impl_->manifold);
+  impl_->problem.AddParameterBlock(n.q, 4, rotation);
   if (first) setFixed(id, true);  // the gauge: a pose graph only determines poses up to one rigid motion
 }
 

@@ -56,6 +56,10 @@ struct PoseGraphConfig {
   RobustLoss loop_loss = RobustLoss::kHuber;
   double loop_loss_scale = 3.0;  // [whitened residual units, i.e. sigmas], > 0
   int threads = 1;               // Ceres threads (Jacobian evaluation, linear solver), >= 1
+  // Nodes turn only about the world z axis (backend::WorldYawManifold: x, y, z and yaw are corrected, roll and pitch
+  // stay as given). For graphs in a gravity-aligned world whose odometry's tilt comes from an IMU (VINS-Mono's
+  // 4-DoF pose graph); a loop's relative roll and pitch then cannot tilt the map away from gravity.
+  bool yaw_only_rotation = false;
   // Empty when valid: max_iterations >= 1, tolerances, initial_trust_region_radius and loop_loss_scale finite
   // and > 0, threads >= 1.
   std::string validate() const;

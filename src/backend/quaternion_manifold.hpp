@@ -40,4 +40,21 @@ class RightQuaternionManifold final : public ceres::Manifold {
   bool MinusJacobian(const double* x, double* jacobian) const override;
 };
 
+// A rotation that may only turn about the WORLD z axis (gravity's, in a gravity-aligned world): one tangent
+// coordinate, the yaw increment dpsi [rad],
+//   Plus(q, dpsi) = Exp(dpsi e_z) (x) q,   Minus(y, x) = the yaw of y (x) x^-1,
+// so the angle between the body axes and the vertical (roll and pitch) never changes. VINS-Mono's 4-DoF pose graph
+// (Qin et al., T-RO 2018, Sec. VIII-B): with an IMU, roll and pitch are observable from gravity and do not drift, so
+// a loop closure corrects x, y, z and yaw only. Same (x, y, z, w) storage as RightQuaternionManifold, and the
+// factors' ambient Jacobians (exact in R^4, see above) serve both.
+class WorldYawManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return 4; }
+  int TangentSize() const override { return 1; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;
+};
+
 }  // namespace drover::backend

@@ -55,7 +55,8 @@ class ImuFusion {
 
   // Moves the smoother and the propagation into a corrected world frame after a loop closure: the smoother
   // restarts at T_new_old * T_world_imu with its velocity rotated and its biases kept (as LIO-SAM re-initialises
-  // its IMU graph on the corrected odometry), and the gyro bias keeps the certainty the old window had of it.
+  // its IMU graph on the corrected odometry), and the gyro bias keeps the certainty the old window had of it; the
+  // accelerometer bias too when the correction turns the world about gravity only (a 4-DoF pose graph).
   void reanchor(const Eigen::Isometry3d& T_new_old);
 
   imu::ImuStreamStats imuStats() const { return propagator_.stats(); }
@@ -65,9 +66,10 @@ class ImuFusion {
 
  private:
   // Smoother and propagation from `state`, under the config's first-state prior; the gyro bias's under the given
-  // covariance [(rad/s)^2] when there is one.
+  // covariance [(rad/s)^2] when there is one, or both biases' under `bias_covariance` [gyro; acc].
   void restart(const imu::NavState& state, const imu::ImuBias& bias,
-               const std::optional<Eigen::Matrix3d>& gyro_bias_covariance = std::nullopt);
+               const std::optional<Eigen::Matrix3d>& gyro_bias_covariance = std::nullopt,
+               const std::optional<Eigen::Matrix<double, 6, 6>>& bias_covariance = std::nullopt);
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
 
   OdometryConfig config_;

@@ -60,7 +60,7 @@ struct LidarOdometry::Impl {
         matcher(c.matcher),
         policy(c.keyframes),
         fusion(c, calib.T_imu_lidar),
-        loops(c.loop) {}
+        loops(c.loopClosure()) {}
 
   std::vector<ScanOutcome> onScan(LidarScan scan);
   std::vector<ScanOutcome> drain(bool force);

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "geometry/so3.hpp"
+#include "pipeline/loop_drift_path.hpp"
 
 namespace drover::pipeline {
 namespace {
@@ -300,20 +301,28 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
 // Rejects a verified loop that would move or turn the query further than the odometry can have drifted (see the
 // config).
 void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& e) {
-  double path = 0;
-  for (std::size_t i = e.candidate + 1; i <= e.query; ++i)
-    path += (map.keyframe(i).T_world_lidar.translation() - map.keyframe(i - 1).T_world_lidar.translation()).norm();
   const Eigen::Isometry3d T_est =
       map.keyframe(e.candidate).T_world_lidar.inverse() * map.keyframe(e.query).T_world_lidar;
-  const double degenerate = degenerate_before[e.query] - degenerate_before[e.candidate];
   e.implied_drift = (e.verification.T_candidate_query.translation() - T_est.translation()).norm();
-  e.drift_budget = config.max_drift_floor + config.max_drift_ratio * path + config.degenerate_drift * degenerate;
   e.implied_rotation = geometry::rotationAngle(T_est.linear().transpose() * e.verification.T_candidate_query.linear());
-  // Only the rotational share of the degenerate directions loosens it: a corridor's degenerate translation says
-  // nothing about the heading.
-  e.rotation_budget =
-      config.max_rotation_drift_floor + config.max_rotation_drift_ratio * path +
-      config.degenerate_rotation_drift * (degenerate_rotation_before[e.query] - degenerate_rotation_before[e.candidate]);
+  // What each odometry step adds to the budgets. Only the rotational share of the degenerate directions loosens the
+  // rotation budget: a corridor's degenerate translation says nothing about the heading.
+  std::vector<DriftStep> translation(e.query + 1), rotation(e.query + 1);
+  for (std::size_t i = 1; i <= e.query; ++i) {
+    const double length =
+        (map.keyframe(i).T_world_lidar.translation() - map.keyframe(i - 1).T_world_lidar.translation()).norm();
+    translation[i] = {length, config.max_drift_ratio * length +
+                                  config.degenerate_drift * (degenerate_before[i] - degenerate_before[i - 1])};
+    rotation[i] = {length, config.max_rotation_drift_ratio * length +
+                               config.degenerate_rotation_drift *
+                                   (degenerate_rotation_before[i] - degenerate_rotation_before[i - 1])};
+  }
+  const std::vector<std::pair<std::size_t, std::size_t>> no_loops;
+  const auto& shortcuts = config.budget_through_loops ? accepted_loops : no_loops;
+  const DriftPath t_path = cheapestDriftPath(translation, shortcuts, e.query, e.candidate);
+  const DriftPath r_path = cheapestDriftPath(rotation, shortcuts, e.query, e.candidate);
+  e.drift_budget = config.max_drift_floor + t_path.cost;
+  e.rotation_budget = config.max_rotation_drift_floor + r_path.cost;
   if (e.implied_drift <= e.drift_budget && e.implied_rotation <= e.rotation_budget) return;
   ++stats.over_drift_budget;
   e.verification.accepted = false;
@@ -321,12 +330,12 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
     e.verification.reason = fmt::format(
         "rejected: the loop moves the query {:.2f} m from the estimate, more than the "
         "drift budget {:.2f} m over {:.1f} m of path ({})",
-        e.implied_drift, e.drift_budget, path, e.verification.reason);
+        e.implied_drift, e.drift_budget, t_path.length, e.verification.reason);
   } else {
     e.verification.reason = fmt::format(
         "rejected: the loop turns the query {:.1f} deg from the estimate, more than the "
         "rotation budget {:.1f} deg over {:.1f} m of path ({})",
-        e.implied_rotation * 180 / std::numbers::pi, e.rotation_budget * 180 / std::numbers::pi, path,
+        e.implied_rotation * 180 / std::numbers::pi, e.rotation_budget * 180 / std::numbers::pi, r_path.length,
         e.verification.reason);
   }
 }

@@ -58,6 +58,14 @@ struct LoopClosureConfig {
   double max_rotation_drift_floor = 0.2;      // [rad] (11 deg)
   double max_rotation_drift_ratio = 0.0005;   // [rad/m] (2.9 deg per 100 m)
   double degenerate_rotation_drift = 0.05;    // [rad] per degenerate direction of a sweep
+  // Both budgets are charged along the cheapest keyframe path between query and candidate where the accepted loops
+  // are free shortcuts (pipeline/loop_drift_path.hpp): on a third pass the budget is the odometry since the place
+  // was last tied by a loop, not the two laps of path between the keyframes' indices (33 deg over 750 m let a
+  // third-lap loop turn a good estimate 31 deg towards a candidate whose own pose was off). With the 4-DoF graph
+  // (four_dof_with_imu) this kept the farm hour's heading within 12 deg (25-56 deg without). Off by default: beside
+  // the 6-DoF graph, whose second-lap corrections can let the corridor's velocity run away (below), the tight
+  // budgets then refused the loops that would have pulled the map back (600 refused by lap 3; bench/RESULTS.md).
+  bool budget_through_loops = false;
   // Retired keyframes keep their own graph node (LIO-SAM: the graph grows with time). Off by default: a retired
   // keyframe's node is merged into the newer keyframe that stands for its place (see retire()).
   bool keep_retired_nodes = false;
@@ -68,6 +76,18 @@ struct LoopClosureConfig {
   // laps more, but the corridor's passes then never coincide, so its keyframes never retire (peak +16 % by lap 3),
   // and an 18 deg jump still came in lap 3 (bench/RESULTS.md).
   bool skip_degenerate_places = false;
+  // With the IMU fused (OdometryConfig::loopClosure), the pose graph corrects x, y, z and yaw only and leaves every
+  // keyframe's roll and pitch as the odometry found them against gravity (VINS-Mono's 4-DoF pose graph), and the
+  // IMU smoother keeps its accelerometer bias at each correction (a turn about gravity does not change it). A 6-DoF
+  // graph tilts the map by up to 1 deg (kitti05-replay); the smoother restarted on tilted poses reads g * tilt as
+  // accelerometer bias (0.028 -> 0.13 m/s^2 over the farm's second lap), which the degenerate corridor then
+  // integrates into a runaway velocity (6 m/s after 50 s, 234 m of drift). With budget_through_loops, the farm hour
+  // (6 laps) keeps a median error of 0.5-0.7 m a lap and a peak memory of 1.27x the first lap's (with neither:
+  // 1.48x, median errors up to 24 m a lap, heading errors up to 56 deg). Off by default: on one pass the 6-DoF graph's tilts also correct the odometry's
+  // height drift (accelerometer bias and tilt are one unknown until the heading turns), and with 4 DoF the APE
+  // rose from 3.58 to 4.58 m on the farm course (in the corridor) and from 0.40 to 0.48 m on kitti05-replay
+  // (height) (bench/RESULTS.md).
+  bool four_dof_with_imu = false;
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };

@@ -20,6 +20,12 @@ OdometryConfig OdometryConfig::kittiHdl64() {
   return c;
 }
 
+LoopClosureConfig OdometryConfig::loopClosure() const {
+  LoopClosureConfig c = loop;
+  c.graph.yaw_only_rotation = use_imu && loop.four_dof_with_imu;
+  return c;
+}
+
 std::string OdometryConfig::validate() const {
   if (deskew_refinements < 0 || deskew_refinements > 10)
     return "deskew_refinements must be in [0, 10], got " + std::to_string(deskew_refinements);

@@ -53,6 +53,9 @@ struct OdometryConfig {
   imu::StaticInitializer::Config initializer;
   backend::FixedLagSmootherConfig smoother;
   LoopClosureConfig loop;  // the `loop:` section of platform configs (on by default)
+  // The loop closure as it runs beside this odometry: `loop`, its pose graph turning nodes about the vertical only
+  // when the IMU is fused and loop.four_dof_with_imu is set (the odometry's roll and pitch are then gravity's).
+  LoopClosureConfig loopClosure() const;
   // Empty when valid, else the first problem found, naming the component and value.
   std::string validate() const;
   // For tools that read KITTI .bin scans without a config file: the HDL-64E as config/kitti.yaml describes it

@@ -96,7 +96,7 @@ struct System::Impl {
         lis(c.odometry, calibration),
         propagator(c.odometry.propagator),
         clocks(fromSeconds(c.live.clock_jump_s), fromSeconds(c.live.sensor_gap_s)) {
-    if (c.odometry.loop.enabled) loops = std::make_unique<LoopWorker>(c.odometry.loop, c.odometry.local_map);
+    if (c.odometry.loop.enabled) loops = std::make_unique<LoopWorker>(c.odometry.loopClosure(), c.odometry.local_map);
     if (c.vis && detector) {
       // Live, the detector runs in the tracker's worker thread (SuperPoint takes ~0.4 s a frame here): KLT tracks
       // every frame meanwhile. The replay keeps it synchronous, hence deterministic.

@@ -21,27 +21,9 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 using geometry::expSE3;
 using geometry::inverse;
 
-// n poses on one turn of a helix (radius 10 m, climbing 2 m), heading along the path, with some roll.
-std::vector<Eigen::Isometry3d> helix(int n) {
-  std::vector<Eigen::Isometry3d> poses;
-  for (int k = 0; k < n; ++k) {
-    const double a = 2 * M_PI * k / n;
-    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-    T.translation() << 10 * std::cos(a), 10 * std::sin(a), 2.0 * k / n;
-    T.linear() = geometry::expSO3(Eigen::Vector3d(0.1 * std::sin(3 * a), 0.05, a + M_PI / 2));
-    poses.push_back(T);
-  }
-  return poses;
-}
-
+using test::helix;
+using test::information;
 using test::randomTangent;
-
-Matrix6d information(double sigma_position, double sigma_rotation) {
-  Vector6d d;
-  d << Eigen::Vector3d::Constant(1 / (sigma_position * sigma_position)),
-      Eigen::Vector3d::Constant(1 / (sigma_rotation * sigma_rotation));
-  return d.asDiagonal();
-}
 
 Eigen::Isometry3d relative(const Eigen::Isometry3d& A, const Eigen::Isometry3d& B) { return inverse(A) * B; }
 

@@ -27,6 +27,8 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   degenerate_rotation_drift: 0.02
   keep_retired_nodes: true
   skip_degenerate_places: true
+  budget_through_loops: true
+  four_dof_with_imu: true
   scan_context:
     sensor_height: 1.5
     auto_height: true
@@ -53,6 +55,9 @@ odometry:
   EXPECT_EQ(c.loop.degenerate_rotation_drift, 0.02);
   EXPECT_TRUE(c.loop.keep_retired_nodes);
   EXPECT_TRUE(c.loop.skip_degenerate_places);
+  EXPECT_TRUE(c.loop.budget_through_loops);
+  EXPECT_TRUE(c.loop.four_dof_with_imu);
+  EXPECT_TRUE(c.loopClosure().graph.yaw_only_rotation);
   EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
   EXPECT_TRUE(c.loop.database.descriptor.auto_height);
   EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);
@@ -64,6 +69,15 @@ odometry:
   EXPECT_EQ(c.loop.graph.loop_loss, backend::RobustLoss::kCauchy);
   EXPECT_EQ(c.loop.graph.loop_loss_scale, 2.0);
   EXPECT_EQ(c.loop.verifier.matcher.max_iterations, 17);  // the verifier matches as the odometry does
+}
+
+TEST(LoopConfigReader, TheLoopGraphIsFourDofOnlyWhenAskedAndTheImuIsFused) {
+  test::TempDir dir;
+  EXPECT_FALSE(load(dir, "loop:\n  enabled: true\n").loopClosure().graph.yaw_only_rotation);  // the default
+  EXPECT_TRUE(load(dir, "loop:\n  four_dof_with_imu: true\n").loopClosure().graph.yaw_only_rotation);
+  EXPECT_FALSE(load(dir, "odometry:\n  use_imu: false\nloop:\n  four_dof_with_imu: true\n")
+                   .loopClosure()
+                   .graph.yaw_only_rotation);
 }
 
 TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {

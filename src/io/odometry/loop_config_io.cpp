@@ -26,6 +26,8 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("degenerate_rotation_drift", c.degenerate_rotation_drift)
       .bind("keep_retired_nodes", c.keep_retired_nodes)
       .bind("skip_degenerate_places", c.skip_degenerate_places)
+      .bind("budget_through_loops", c.budget_through_loops)
+      .bind("four_dof_with_imu", c.four_dof_with_imu)
       .nested("scan_context",
               [&](YamlSection& n) {
                 n.bind("rings", d.rings)
