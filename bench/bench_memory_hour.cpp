@@ -7,7 +7,8 @@
 //
 // After every lap it prints the process's resident memory (VmRSS) and peak (VmHWM), the keyframes and the bytes of
 // their feature clouds (the LIS's map and the loop thread's store), and at the end the ratio of the hour's peak to
-// the first lap's (the 10-minute course), overall and without the keyframe clouds.
+// the first lap's (the 10-minute course), overall and without the keyframe clouds. Also malloc's own account
+// (mallinfo2, all arenas): the bytes in blocks in use and the free bytes it keeps, to tell growth from fragmentation.
 // MODE replay drives the same laps through the deterministic replay (LidarOdometry with its loop closure in line,
 // as drover run): the same numbers, reproducible, plus each lap's loop-closure counts (verified, accepted, refused
 // by the drift budget, refused by the pose graph) to follow the loop closure over hours.
@@ -21,6 +22,7 @@
 //   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay|delayed] [LOOP_HZ=1] [CONFIG]
 // CONFIG: a platform file instead of config/farm_sim.yaml (to try a setting over the hour).
 #include <fmt/format.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <cmath>
@@ -63,6 +65,7 @@ struct Lap {
   int lap = 0;
   double data_s = 0, wall_s = 0;
   long rss_kb = 0, peak_kb = 0;
+  std::size_t heap_used = 0, heap_free = 0;  // [bytes] malloc's blocks in use, and held free (all arenas, mallinfo2)
   std::size_t sweeps = 0, keyframes = 0, dropped = 0, loops = 0;
   std::size_t kf_lis = 0, kf_loop = 0;  // [bytes] keyframe clouds held by the LIS, and by the loop thread alone
   std::size_t retired = 0;               // keyframes whose clouds were freed (a newer one stands for the place)
@@ -231,7 +234,7 @@ class DelayedRunner : public InlineRunner {
  public:
   DelayedRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration, double period_s)
       : InlineRunner(odometry, calibration),
-        worker_(odometry.loop, odometry.local_map),
+        worker_(odometry.loopClosure(), odometry.local_map),
         period_(fromSeconds(period_s)) {
     lis_.setKeyframeListener([this](const pipeline::KeyframeRecord& k) { pending_.push_back(k); }, true);
   }
@@ -302,7 +305,7 @@ int main(int argc, char** argv) {
   const auto wall0 = std::chrono::steady_clock::now();
   std::printf("%s: lap  data_s  wall_s  sweeps  keyframes  retired  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  "
               "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms  iterations  "
-              "max_rot_deg  graph_nodes\n",
+              "max_rot_deg  graph_nodes  heap_used_MB  heap_free_MB\n",
               mode.c_str());
   for (int lap = 0; lap < laps; ++lap) {
     const Time offset = lap * lap_span;
@@ -327,15 +330,18 @@ int main(int argc, char** argv) {
     runner->fill(row);
     row.rss_kb = statusKb("VmRSS");
     row.peak_kb = statusKb("VmHWM");
+    const struct mallinfo2 heap = mallinfo2();
+    row.heap_used = heap.uordblks + heap.hblkhd;
+    row.heap_free = heap.fordblks;
     rows.push_back(row);
     const pipeline::LoopStats& ls = row.loop_stats;
     std::printf("%3d  %6.0f  %6.0f  %6zu  %9zu  %7zu  %5zu  %7zu  %6.1f  %7.1f  %9.1f  %10.1f  %8.1f  %5.1f  | %8zu  "
-                "%8zu  %11zu  %13zu  %8.0f  %10.1f  %11.1f  %11zu\n",
+                "%8zu  %11zu  %13zu  %8.0f  %10.1f  %11.1f  %11zu  %12.1f  %12.1f\n",
                 row.lap, row.data_s, row.wall_s, row.sweeps, row.keyframes, row.retired, row.loops, row.dropped,
                 row.rss_kb / 1024.0, row.peak_kb / 1024.0, row.kf_lis / 1048576.0, row.kf_loop / 1048576.0,
                 row.cache / 1048576.0, row.descriptors / 1048576.0, ls.verified, ls.accepted, ls.over_drift_budget,
                 row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / std::numbers::pi,
-                row.graph_nodes);
+                row.graph_nodes, row.heap_used / 1048576.0, row.heap_free / 1048576.0);
     std::fflush(stdout);
   }
   runner->finish();
