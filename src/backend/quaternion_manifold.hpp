@@ -44,8 +44,8 @@ class RightQuaternionManifold final : public ceres::Manifold {
 // coordinate, the yaw increment dpsi [rad],
 //   Plus(q, dpsi) = Exp(dpsi e_z) (x) q,   Minus(y, x) = the yaw of y (x) x^-1,
 // so the angle between the body axes and the vertical (roll and pitch) never changes. VINS-Mono's 4-DoF pose graph
-// (Qin et al., T-RO 2018, Sec. VIII-B): with an IMU, roll and pitch are observable from gravity and do not drift, so
-// a loop closure corrects x, y, z and yaw only. Same (x, y, z, w) storage as RightQuaternionManifold, and the
+// (Qin et al., T-RO 2018, Sec. VIII-B): with an IMU, roll and pitch are observable from gravity (once turns have
+// told a tilt from an accelerometer bias), so a loop closure corrects x, y, z and yaw only. Same (x, y, z, w) storage as RightQuaternionManifold, and the
 // factors' ambient Jacobians (exact in R^4, see above) serve both.
 class WorldYawManifold final : public ceres::Manifold {
  public:
