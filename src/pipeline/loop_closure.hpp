@@ -83,10 +83,10 @@ struct LoopClosureConfig {
   // accelerometer bias (0.028 -> 0.13 m/s^2 over the farm's second lap), which the degenerate corridor then
   // integrates into a runaway velocity (6 m/s after 50 s, 234 m of drift). With budget_through_loops, the farm hour
   // (6 laps) keeps a median error of 0.5-0.7 m a lap and a peak memory of 1.27x the first lap's (with neither:
-  // 1.48x, median errors up to 24 m a lap, heading errors up to 56 deg). Off by default: on one pass the 6-DoF graph's tilts also correct the odometry's
-  // height drift (accelerometer bias and tilt are one unknown until the heading turns), and with 4 DoF the APE
-  // rose from 3.58 to 4.58 m on the farm course (in the corridor) and from 0.40 to 0.48 m on kitti05-replay
-  // (height) (bench/RESULTS.md).
+  // 1.48x, median errors up to 24 m a lap, heading errors up to 56 deg). Off by default: on one pass the 6-DoF
+  // graph's tilts also correct the odometry's height drift (accelerometer bias and tilt are one unknown until the
+  // heading turns), and with 4 DoF the APE rose from 3.58 to 4.58 m on the farm course (in and after the corridor)
+  // and from 0.40 to 0.48 m on kitti05-replay (height) (bench/RESULTS.md).
   bool four_dof_with_imu = false;
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
