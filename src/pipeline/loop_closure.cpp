@@ -307,8 +307,9 @@ void LoopClosure::Impl::checkDriftBudget(const lidar::LocalMap& map, LoopEvent& 
   e.implied_rotation = geometry::rotationAngle(T_est.linear().transpose() * e.verification.T_candidate_query.linear());
   // What each odometry step adds to the budgets. Only the rotational share of the degenerate directions loosens the
   // rotation budget: a corridor's degenerate translation says nothing about the heading.
+  // Without the loops as shortcuts the path is the chain from the candidate: the steps before it are never charged.
   std::vector<DriftStep> translation(e.query + 1), rotation(e.query + 1);
-  for (std::size_t i = 1; i <= e.query; ++i) {
+  for (std::size_t i = config.budget_through_loops ? 1 : e.candidate + 1; i <= e.query; ++i) {
     const double length =
         (map.keyframe(i).T_world_lidar.translation() - map.keyframe(i - 1).T_world_lidar.translation()).norm();
     translation[i] = {length, config.max_drift_ratio * length +
