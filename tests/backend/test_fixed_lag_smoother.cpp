@@ -259,6 +259,33 @@ TEST(FixedLagSmoother, TheGyroBiasCovarianceIsTheWindowsCertaintyAndItsErrorLies
       std::invalid_argument);
 }
 
+// Feeds `kept` and `loose` (both initialised at the start) 12 s of the scenario, 120 sweeps. From sweep 71 on, every
+// 5th sweep a loop correction (0.02 rad of yaw and a few cm) moves the smoothers' world and restart(smoother, T,
+// keep_certainty) restarts each there; perturb(k, measured) alters the lidar pose of every sweep k > 70; after(k)
+// is called once both have taken sweep k.
+template <typename Restart, typename Perturb, typename After>
+void runWithLoopRestarts(const Scenario& s, FixedLagSmoother& kept, FixedLagSmoother& loose, Restart restart,
+                         Perturb perturb, After after) {
+  PoseNoise noise;
+  Eigen::Isometry3d T_world_truth = Eigen::Isometry3d::Identity();  // the smoothers' world, from the truth's
+  for (int k = 1; k <= 120; ++k) {
+    const Time t0 = (k - 1) * kLidarPeriod, t1 = k * kLidarPeriod;
+    if (k > 70 && k % 5 == 0) {
+      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+      T.linear() = geometry::expSO3(Eigen::Vector3d(0, 0, 0.02));
+      T.translation() = Eigen::Vector3d(0.05, 0.02, -0.01);
+      T_world_truth = T * T_world_truth;
+      restart(kept, T, true);
+      restart(loose, T, false);
+    }
+    Eigen::Isometry3d measured = T_world_truth * noise.apply(s.truth(t1).T_world_imu);
+    if (k > 70) perturb(k, T_world_truth, measured);
+    ASSERT_TRUE(kept.update(preintegrate(s, t0, t1, kept.bias()), measured).ok) << k;
+    ASSERT_TRUE(loose.update(preintegrate(s, t0, t1, loose.bias()), measured).ok) << k;
+    after(k);
+  }
+}
+
 TEST(FixedLagSmoother, RestartedAtEveryLoopWithItsGyroCertaintyItHoldsTheBiasAgainstAHeadingWalk) {
   // The farm's second lap: loops every few seconds, and a stretch where the scan matcher's heading walks off.
   // After 7 s the gyro bias is known; then for 5 s the lidar's heading drifts at 0.003 rad/s, and every 0.5 s a loop
@@ -269,23 +296,13 @@ TEST(FixedLagSmoother, RestartedAtEveryLoopWithItsGyroCertaintyItHoldsTheBiasAga
   FixedLagSmoother kept, loose;
   kept.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
   loose.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
-  PoseNoise noise;
-  Eigen::Isometry3d T_world_truth = Eigen::Isometry3d::Identity();  // the smoothers' world, from the truth's
-  for (int k = 1; k <= 120; ++k) {
-    const Time t0 = (k - 1) * kLidarPeriod, t1 = k * kLidarPeriod;
-    if (k > 70 && k % 5 == 0) {
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      T.linear() = geometry::expSO3(Eigen::Vector3d(0, 0, 0.02));
-      T.translation() = Eigen::Vector3d(0.05, 0.02, -0.01);
-      T_world_truth = T * T_world_truth;
-      restartMoved(kept, T, s.preintegration, true);
-      restartMoved(loose, T, s.preintegration, false);
-    }
-    Eigen::Isometry3d measured = T_world_truth * noise.apply(s.truth(t1).T_world_imu);
-    if (k > 70) measured.linear() = Eigen::AngleAxisd(0.003 * (k - 70) * 0.1, Eigen::Vector3d::UnitZ()) * measured.linear();
-    ASSERT_TRUE(kept.update(preintegrate(s, t0, t1, kept.bias()), measured).ok) << k;
-    ASSERT_TRUE(loose.update(preintegrate(s, t0, t1, loose.bias()), measured).ok) << k;
-  }
+  ASSERT_NO_FATAL_FAILURE(runWithLoopRestarts(
+      s, kept, loose,
+      [&](FixedLagSmoother& f, const Eigen::Isometry3d& T, bool keep) { restartMoved(f, T, s.preintegration, keep); },
+      [](int k, const Eigen::Isometry3d&, Eigen::Isometry3d& measured) {
+        measured.linear() = Eigen::AngleAxisd(0.003 * (k - 70) * 0.1, Eigen::Vector3d::UnitZ()) * measured.linear();
+      },
+      [](int) {}));
   const double kept_error = (kept.bias().gyro - s.imu_model.initial_gyro_bias).norm();
   const double loose_error = (loose.bias().gyro - s.imu_model.initial_gyro_bias).norm();
   std::printf("gyro bias error after 5 s of heading walk and 10 restarts: certainty kept %.2e, loose %.2e rad/s\n",
@@ -304,35 +321,25 @@ TEST(FixedLagSmoother, RestartedAtEveryYawOnlyLoopWithBothBiasesCertaintyItHolds
   FixedLagSmoother kept, loose;
   kept.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
   loose.initialize(s.truth(0), imu::ImuBias{}, s.preintegration);
-  PoseNoise noise;
   Eigen::Vector3d before = Eigen::Vector3d::Zero();  // [m/s^2] the accelerometer bias when the creep starts
-  Eigen::Isometry3d T_world_truth = Eigen::Isometry3d::Identity();
-  for (int k = 1; k <= 120; ++k) {
-    const Time t0 = (k - 1) * kLidarPeriod, t1 = k * kLidarPeriod;
-    if (k > 70 && k % 5 == 0) {
-      Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-      T.linear() = geometry::expSO3(Eigen::Vector3d(0, 0, 0.02));
-      T.translation() = Eigen::Vector3d(0.05, 0.02, -0.01);
-      T_world_truth = T * T_world_truth;
-      for (FixedLagSmoother* f : {&kept, &loose}) {
-        const std::optional<Eigen::Matrix<double, 6, 6>> C = f->biasCovariance();
-        ASSERT_TRUE(C.has_value());
-        imu::NavState x = f->state();
-        x.T_world_imu = T * x.T_world_imu;
-        x.v_world = T.linear() * x.v_world;
-        const imu::ImuBias b = f->bias();
-        f->reset();
-        if (f == &kept) f->initialize(x, b, s.preintegration, *C);
-        else f->initialize(x, b, s.preintegration);
-      }
-    }
-    Eigen::Isometry3d measured = T_world_truth * noise.apply(s.truth(t1).T_world_imu);
-    const double creep_s = k > 70 ? (k - 70) * 0.1 : 0.0;
-    if (k > 70) measured.translation() += T_world_truth.linear() * Eigen::Vector3d(0.5 * 0.05 * creep_s * creep_s, 0, 0);
-    ASSERT_TRUE(kept.update(preintegrate(s, t0, t1, kept.bias()), measured).ok) << k;
-    ASSERT_TRUE(loose.update(preintegrate(s, t0, t1, loose.bias()), measured).ok) << k;
+  const auto restart = [&](FixedLagSmoother& f, const Eigen::Isometry3d& T, bool keep) {
+    const std::optional<Eigen::Matrix<double, 6, 6>> C = f.biasCovariance();
+    ASSERT_TRUE(C.has_value());
+    imu::NavState x = f.state();
+    x.T_world_imu = T * x.T_world_imu;
+    x.v_world = T.linear() * x.v_world;
+    const imu::ImuBias b = f.bias();
+    f.reset();
+    if (keep) f.initialize(x, b, s.preintegration, *C);
+    else f.initialize(x, b, s.preintegration);
+  };
+  const auto creep = [](int k, const Eigen::Isometry3d& T_world_truth, Eigen::Isometry3d& measured) {
+    const double creep_s = (k - 70) * 0.1;
+    measured.translation() += T_world_truth.linear() * Eigen::Vector3d(0.5 * 0.05 * creep_s * creep_s, 0, 0);
+  };
+  ASSERT_NO_FATAL_FAILURE(runWithLoopRestarts(s, kept, loose, restart, creep, [&](int k) {
     if (k == 70) before = kept.bias().acc;  // the same in both: no restart yet
-  }
+  }));
   const double kept_moved = (kept.bias().acc - before).norm();
   const double loose_moved = (loose.bias().acc - before).norm();
   std::printf("acc bias moved in 5 s of creep and 10 yaw-only restarts: certainty kept %.2e, loose %.2e m/s^2 "
