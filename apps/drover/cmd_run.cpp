@@ -273,6 +273,8 @@ void runOdometry(const RunOptions& o) {
     if (const auto* frame = std::get_if<CameraFrame>(&*m)) {
       if (!cameraUsable(reader->calibration(), no_lidar, o, camera_warned)) continue;
       visFor().onFrame(*frame, no_lidar ? nullptr : &odometry);
+      if (!no_lidar)
+        if (std::optional<pipeline::VisualState> state = vis->takeState()) odometry.addVisualState(*state);
       continue;
     }
     if (const auto* sample = std::get_if<ImuSample>(&*m)) {

@@ -92,6 +92,8 @@ Json statsJson(const pipeline::OdometryStats& s, const RunRecord& r) {
   j["not_converged"] = s.not_converged;
   j["smoother_resets"] = s.smoother_resets;
   j["imu_scans"] = s.imu_scans;
+  j["vis_guess_scans"] = s.vis_guess_scans;    // sweeps matched from the VIS's motion (LVI-SAM's initial guess)
+  j["vis_factor_scans"] = s.vis_factor_scans;  // sweeps whose IMU smoother had the VIS's motion as a factor
   j["imu_initialized"] = s.imu_initialized;
   j["imu_init"] = s.imu_init;
   j["imu"] = {{"accepted", s.imu.accepted},

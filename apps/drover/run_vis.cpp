@@ -118,9 +118,16 @@ void RunVis::record(const vio::VisFrame& f) {
   } else if (!r.initialized && !r.event.empty()) {
     waiting_ = r.event;
   }
+  new_state_ = states_.onFrame(r);
   if (r.initialized) trajectory_.push_back({r.t, r.T_world_imu});
   records_.push_back({r.t, r.initialized, r.keyframe, f.detected, f.front_tracked, r.features, r.with_lidar_depth,
                       r.outliers, r.iterations, f.share_three, f.ms});
+}
+
+std::optional<pipeline::VisualState> RunVis::takeState() {
+  std::optional<pipeline::VisualState> s = std::move(new_state_);
+  new_state_.reset();
+  return s;
 }
 
 Json RunVis::report() const {

@@ -53,6 +53,10 @@ class RunVis {
   // The newest LIS sweep with a fused IMU state (its velocity and biases seed the VIS).
   void onLisState(const pipeline::ScanOutcome& outcome);
 
+  // The VIS's state after the newest frame, once (for the LIS's VIS fusion, LidarOdometry::addVisualState);
+  // nothing when that frame had no estimate or it was taken.
+  std::optional<pipeline::VisualState> takeState();
+
   const Trajectory& trajectory() const { return trajectory_; }  // T_world_imu at every initialised frame
   const std::string& detectorName() const { return detector_name_; }
   // report.json's "vis" section (without the APE, which the caller adds).
@@ -78,6 +82,8 @@ class RunVis {
   std::optional<pipeline::ScanOutcome> lis_state_;
   std::size_t frames_in_ = 0, frames_bad_ = 0, resets_ = 0;
   std::optional<Time> first_init_;
+  pipeline::VisualStateStream states_;
+  std::optional<pipeline::VisualState> new_state_;
 };
 
 }  // namespace drover::cli

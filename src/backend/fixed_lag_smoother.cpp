@@ -171,10 +171,14 @@ SmootherUpdate FixedLagSmoother::update(const imu::Preintegrator& pim, const Eig
 }
 
 SmootherUpdate FixedLagSmoother::update(const imu::Preintegrator& pim, const Eigen::Isometry3d& T_world_imu_measured,
-                                        const Eigen::Matrix<double, 6, 6>& pose_sqrt_information) {
+                                        const Eigen::Matrix<double, 6, 6>& pose_sqrt_information,
+                                        const std::optional<RelativePoseMeasurement>& relative) {
   if (!impl_->initialized) throw std::invalid_argument("FixedLagSmoother::update: not initialized");
   if (!T_world_imu_measured.matrix().allFinite() || !pose_sqrt_information.allFinite()) {
     throw std::invalid_argument("FixedLagSmoother::update: pose measurement or its information is not finite");
+  }
+  if (relative && (!relative->T_i_j.matrix().allFinite() || !relative->sqrt_information.allFinite())) {
+    throw std::invalid_argument("FixedLagSmoother::update: relative pose or its information is not finite");
   }
   // Fails early (std::invalid_argument) on dt <= 0 or a singular covariance, before the window changes.
   const ImuPreintegrationFactor check(pim);
@@ -188,6 +192,10 @@ SmootherUpdate FixedLagSmoother::update(const imu::Preintegrator& pim, const Eig
   node.pim = pim;
   node.pose_measured = T_world_imu_measured;
   node.pose_sqrt_information = pose_sqrt_information;
+  if (relative) {
+    node.relative_measured = relative->T_i_j;
+    node.relative_sqrt_information = relative->sqrt_information;
+  }
   w.nodes.push_back(std::move(node));
 
   SmootherUpdate result = impl_->solve(SmootherUpdate{});

@@ -41,6 +41,14 @@ struct FixedLagSmootherConfig {
   std::string validate() const;
 };
 
+// A relative pose measurement between the newest state i and the state update() adds, j (visual odometry:
+// the VIS's motion between two sweeps): T_i_j = T_world_imu_i^-1 T_world_imu_j, whitened by the 6x6 square-root
+// information of the error [dp in frame i (m); dtheta (rad, right perturbation)] (RelativePoseFactor).
+struct RelativePoseMeasurement {
+  Eigen::Isometry3d T_i_j = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
+};
+
 struct SmootherUpdate {
   bool ok = false;        // solved, finite and plausible; the window moved on
   bool failure = false;   // the solution was implausible or not finite: the caller should reset()
@@ -86,8 +94,11 @@ class FixedLagSmoother {
   // Initial values from pim.predict(); solves; slides the window. Never throws on a failed solve (reports
   // failure, and rolls the window back to before the call); throws std::invalid_argument when not initialized,
   // pim.deltaTime() <= 0, the pim's covariance is not positive definite, or the inputs are not finite.
+  // With `relative`, also that relative pose between the newest state and the new one (it enters the
+  // marginalisation like the IMU factor when the newest state leaves the window).
   SmootherUpdate update(const imu::Preintegrator& pim, const Eigen::Isometry3d& T_world_imu_measured,
-                        const Eigen::Matrix<double, 6, 6>& pose_sqrt_information);
+                        const Eigen::Matrix<double, 6, 6>& pose_sqrt_information,
+                        const std::optional<RelativePoseMeasurement>& relative = std::nullopt);
   // The same with the config's lidar_sigma_position / lidar_sigma_rotation.
   SmootherUpdate update(const imu::Preintegrator& pim, const Eigen::Isometry3d& T_world_imu_measured);
 

@@ -58,8 +58,13 @@ void SmootherWindow::buildProblem(ceres::Problem& problem, ceres::Manifold* mani
       problem.AddResidualBlock(new PosePriorFactor(*node.pose_measured, node.pose_sqrt_information), nullptr,
                                node.p.data(), node.q.data());
     }
-    if (k == 0 || !node.pim) continue;
+    if (k == 0) continue;
     WindowNode& prev = nodes[k - 1];
+    if (node.relative_measured) {
+      problem.AddResidualBlock(new RelativePoseFactor(*node.relative_measured, node.relative_sqrt_information),
+                               nullptr, prev.p.data(), prev.q.data(), node.p.data(), node.q.data());
+    }
+    if (!node.pim) continue;
     problem.AddResidualBlock(new ImuPreintegrationFactor(*node.pim), nullptr, prev.p.data(), prev.q.data(),
                              prev.v.data(), prev.b.data(), node.p.data(), node.q.data(), node.v.data());
     problem.AddResidualBlock(new BiasRandomWalkFactor(gyro_random_walk, acc_random_walk, node.pim->deltaTime()),
@@ -84,10 +89,12 @@ std::string SmootherWindow::marginalizeFront() {
     add(new ImuPreintegrationFactor(*r.pim), {0, 1, 2, 3, 4, 5, 6});
     add(new BiasRandomWalkFactor(gyro_random_walk, acc_random_walk, r.pim->deltaTime()), {3, 7});
   }
+  if (r.relative_measured) add(new RelativePoseFactor(*r.relative_measured, r.relative_sqrt_information), {0, 1, 4, 5});
   const MarginalPrior result = marginalizeState(terms, m.blocks(), r.blocks());
   if (!result.ok) return result.reason;
   prior = {result.linearization, result.sqrt_information, result.offset};
-  r.pim.reset();  // its factor now lives in the prior
+  r.pim.reset();  // its factors now live in the prior
+  r.relative_measured.reset();
   nodes.pop_front();
   return {};
 }

@@ -26,6 +26,8 @@ struct WindowNode {
   std::optional<imu::Preintegrator> pim;          // IMU from the previous node to this one
   std::optional<Eigen::Isometry3d> pose_measured;  // lidar odometry T_world_imu
   Matrix6d pose_sqrt_information = Matrix6d::Identity();
+  std::optional<Eigen::Isometry3d> relative_measured;  // T_prev_this from visual odometry (RelativePoseFactor)
+  Matrix6d relative_sqrt_information = Matrix6d::Identity();
 
   std::array<double*, 4> blocks() { return {p.data(), q.data(), v.data(), b.data()}; }
   void set(const imu::NavState& state, const imu::ImuBias& bias);

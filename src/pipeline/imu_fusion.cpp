@@ -36,7 +36,8 @@ ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_im
       T_lidar_imu_(T_imu_lidar.inverse()),
       propagator_(config.propagator),
       initializer_(config.initializer),
-      smoother_(config.smoother) {}
+      smoother_(config.smoother),
+      visual_(config.vis_fusion, config.preintegration) {}
 
 imu::SampleStatus ImuFusion::addImu(const ImuSample& sample) { return propagator_.addSample(sample); }
 
@@ -156,11 +157,21 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     return;
   }
   const Eigen::Matrix<double, 6, 6> L = poseSqrtInformation(out, T_world_imu_measured);
+  std::optional<backend::RelativePoseMeasurement> visual;
+  if (config_.vis_fusion.factor && !visual_.empty()) {
+    std::string why;
+    if (const std::optional<VisualIncrement> inc = visual_.increment(previous.t, out.t, propagator_, &why)) {
+      visual = backend::RelativePoseMeasurement{inc->T_a_b, inc->sqrt_information};
+      out.vis_factor = true;
+    } else {
+      out.vis_unused = why;
+    }
+  }
   backend::SmootherUpdate r;
   try {
     imu::Preintegrator pim(smoother_.bias(), config_.preintegration);
     pim.integrateRange(samples, previous.t, out.t);
-    r = smoother_.update(pim, T_world_imu_measured, L);
+    r = smoother_.update(pim, T_world_imu_measured, L, visual);
   } catch (const std::invalid_argument& e) {
     r.failure = true;
     r.reason = e.what();
@@ -184,6 +195,14 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   } else if (config_.gravity_roll_pitch) {
     out.T_world_lidar.linear() = geometry::withRollPitchOf(out.T_world_lidar.linear(), T_world_lidar_fused.linear());
   }
+}
+
+std::optional<Eigen::Isometry3d> ImuFusion::visualLidarGuess(Time t, const StampedPose& previous,
+                                                              std::string* why) const {
+  if (!config_.vis_fusion.initial_guess || visual_.empty() || !initialized_) return std::nullopt;
+  const std::optional<VisualIncrement> inc = visual_.increment(previous.t, t, propagator_, why);
+  if (!inc) return std::nullopt;
+  return previous.T_world_body * T_lidar_imu_ * inc->T_a_b * T_imu_lidar_;
 }
 
 // Sigma of the lidar pose: lidar_sigma_position/rotation, plus degenerate_sigma along each degenerate direction of

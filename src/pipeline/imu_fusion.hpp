@@ -12,6 +12,7 @@
 #include "imu/propagator.hpp"
 #include "lidar/deskew.hpp"
 #include "pipeline/odometry_config.hpp"
+#include "pipeline/visual_motion.hpp"
 #include "types/imu.hpp"
 #include "types/trajectory.hpp"
 
@@ -59,6 +60,14 @@ class ImuFusion {
   // accelerometer bias too when the correction turns the world about gravity only (a 4-DoF pose graph).
   void reanchor(const Eigen::Isometry3d& T_new_old);
 
+  // The VIS's newest state after a camera frame (time order): its motion between sweeps then enters update() as a
+  // relative-pose factor and visualLidarGuess() as the matcher's guess, while config.vis_fusion allows and the VIS
+  // is healthy (pipeline/visual_motion.hpp).
+  void addVisualState(const VisualState& state) { visual_.add(state); }
+  // LVI-SAM's updateInitialGuess: the lidar pose at t as the pose of the sweep `previous` (T_world_lidar) moved by
+  // the VIS's motion between the two stamps; nullopt with `why` when the VIS cannot give it or the option is off.
+  std::optional<Eigen::Isometry3d> visualLidarGuess(Time t, const StampedPose& previous, std::string* why) const;
+
   imu::ImuStreamStats imuStats() const { return propagator_.stats(); }
   // The smoother's newest fused state and bias (what the IMU-rate propagation starts from); nullopt before the
   // smoother runs. The live system re-anchors its own IMU-rate propagation on it after every sweep.
@@ -77,6 +86,7 @@ class ImuFusion {
   imu::ImuPropagator propagator_;
   imu::StaticInitializer initializer_;
   backend::FixedLagSmoother smoother_;
+  VisualMotion visual_;
   bool initialized_ = false, given_up_ = false;
   std::string init_note_ = "no IMU data";
   Eigen::Isometry3d T_world_imu0_ = Eigen::Isometry3d::Identity();

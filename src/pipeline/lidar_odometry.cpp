@@ -71,6 +71,8 @@ Trajectory LidarOdometry::keyframeTrajectory() const {
 
 void LidarOdometry::setSweepListener(SweepListener listener) { impl_->sweep_listener = std::move(listener); }
 
+void LidarOdometry::addVisualState(const VisualState& state) { impl_->fusion.addVisualState(state); }
+
 void LidarOdometry::setKeyframeListener(KeyframeListener listener, bool external_loops) {
   impl_->keyframe_listener = std::move(listener);
   impl_->external_loops = external_loops;

@@ -38,6 +38,9 @@ struct ScanOutcome {
   Eigen::Isometry3d T_world_lidar = Eigen::Isometry3d::Identity();  // estimate at t
   bool keyframe = false;
   bool imu_used = false;          // deskew and guess came from the IMU propagation
+  bool vis_guess = false;         // the matcher's guess was the VIS's motion since the previous sweep
+  bool vis_factor = false;        // the VIS's motion entered the IMU smoother as a relative-pose factor
+  std::string vis_unused;         // why not, while a VIS runs (empty when it was used or none runs)
   std::string match_status;       // lidar::toString(MatchStatus), "first" for the first sweep
   std::string match_reason;       // the matcher's one-line reason
   bool converged = false;
@@ -75,6 +78,8 @@ struct OdometryStats {
   std::size_t not_converged = 0;         // matches that stopped without converging (pose kept from the guess)
   std::size_t smoother_resets = 0;
   std::size_t imu_scans = 0;             // sweeps deskewed and predicted with the IMU
+  std::size_t vis_guess_scans = 0;       // sweeps whose matcher guess was the VIS's motion
+  std::size_t vis_factor_scans = 0;      // sweeps whose smoother update had the VIS's motion as a factor
   bool imu_initialized = false;
   std::string imu_init;                  // how the IMU was initialised (or why not)
   imu::ImuStreamStats imu;
@@ -150,6 +155,10 @@ class LidarOdometry {
   using SweepListener = std::function<void(Time t, const Eigen::Isometry3d& T_world_lidar,
                                            const std::vector<Eigen::Vector3f>& points_lidar)>;
   void setSweepListener(SweepListener listener);
+  // The VIS's newest state after each of its camera frames, in time order (LVI-SAM's VIS -> LIS link): while the
+  // VIS is healthy, its motion between sweeps is the matcher's initial guess and a relative-pose factor in the IMU
+  // smoother (config().vis_fusion; pipeline/visual_motion.hpp). Ignored without the IMU.
+  void addVisualState(const VisualState& state);
 
   // Live use (pipeline::System): every new keyframe goes to `listener`; with `external_loops` the in-line loop
   // closure no longer runs (loopClosure() stays empty) and the loops come back through applyLoopCorrection. Set

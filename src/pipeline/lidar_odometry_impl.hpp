@@ -66,7 +66,7 @@ struct LidarOdometry::Impl {
   std::vector<ScanOutcome> drain(bool force);
   std::optional<ScanOutcome> processScan(LidarScan& scan);
   bool preprocess(LidarScan& scan, ScanOutcome& out);
-  Eigen::Isometry3d guess(Time t, bool& from_imu) const;
+  Eigen::Isometry3d guess(Time t, bool& from_imu, ScanOutcome& out) const;
   lidar::FeatureSet deskewAndExtract(const LidarScan& scan, const std::optional<lidar::SweepMotion>& motion,
                                      ScanOutcome& out) const;
   void match(const lidar::FeatureSet& features, const Eigen::Isometry3d& guess, ScanOutcome& out);

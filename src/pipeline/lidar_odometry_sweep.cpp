@@ -71,7 +71,7 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
     }
   }
   bool from_imu = false;
-  const Eigen::Isometry3d T_guess = guess(scan.t, from_imu);
+  const Eigen::Isometry3d T_guess = guess(scan.t, from_imu, out);
   out.imu_used = out.imu_used || from_imu;
   lidar::FeatureSet features = deskewAndExtract(scan, motion, out);
   match(features, T_guess, out);
@@ -93,6 +93,8 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
     stats.reset_times.push_back(scan.t);
   }
   if (out.imu_used) ++stats.imu_scans;
+  if (out.vis_guess) ++stats.vis_guess_scans;
+  if (out.vis_factor) ++stats.vis_factor_scans;
 
   accumulateDegeneracy(out);
   if (sweep_listener) sweep_listener(scan.t, out.T_world_lidar, features.full);
@@ -126,8 +128,15 @@ bool LidarOdometry::Impl::preprocess(LidarScan& scan, ScanOutcome& out) {
   return true;
 }
 
-// IMU prediction when the fusion is running, else constant velocity from the last two poses.
-Eigen::Isometry3d LidarOdometry::Impl::guess(Time t, bool& from_imu) const {
+// The VIS's motion since the previous sweep while a healthy VIS runs (LVI-SAM), else the IMU prediction when the
+// fusion is running, else constant velocity from the last two poses.
+Eigen::Isometry3d LidarOdometry::Impl::guess(Time t, bool& from_imu, ScanOutcome& out) const {
+  if (!recent.empty()) {
+    if (std::optional<Eigen::Isometry3d> p = fusion.visualLidarGuess(t, recent.back(), &out.vis_unused)) {
+      out.vis_guess = from_imu = true;  // the VIS's motion is visual-inertial
+      return *p;
+    }
+  }
   if (std::optional<Eigen::Isometry3d> p = fusion.predictLidarPose(t)) {
     from_imu = true;
     return *p;

@@ -42,7 +42,8 @@ std::string OdometryConfig::validate() const {
       {"local_map", local_map.validate()},    {"matcher", matcher.validate()},
       {"keyframes", keyframes.validate()},    {"preintegration", preintegration.validate()},
       {"propagator", propagator.validate()},  {"initializer", initializer.validate()},
-      {"smoother", smoother.validate()},      {"loop", loop.validate()}};
+      {"smoother", smoother.validate()},      {"loop", loop.validate()},
+      {"vis_fusion", vis_fusion.validate()}};
   for (const auto& [name, error] : parts)
     if (!error.empty()) return prefixed(name, error);
   return {};

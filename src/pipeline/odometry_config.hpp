@@ -14,6 +14,7 @@
 #include "lidar/scan_layout.hpp"
 #include "lidar/scan_matcher.hpp"
 #include "pipeline/loop_closure.hpp"
+#include "pipeline/visual_motion.hpp"
 
 namespace drover::pipeline {
 
@@ -52,6 +53,7 @@ struct OdometryConfig {
   imu::ImuPropagator::Config propagator;
   imu::StaticInitializer::Config initializer;
   backend::FixedLagSmootherConfig smoother;
+  VisualMotionConfig vis_fusion;  // how the VIS's motion enters the LIS (used only while a VIS runs)
   LoopClosureConfig loop;  // the `loop:` section of platform configs (on by default)
   // The loop closure as it runs beside this odometry: `loop`, its pose graph turning nodes about the vertical only
   // when the IMU is fused and loop.four_dof_with_imu is set (the odometry's roll and pitch are then gravity's).

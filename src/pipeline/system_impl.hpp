@@ -70,6 +70,12 @@ struct System::Impl {
   // Held by the LIS thread while it changes the LIS, and by the loop thread while it searches: inspect() takes both.
   mutable std::mutex lis_state_mutex, loop_state_mutex;
 
+  // The VIS's states for the LIS (VIS -> LIS fusion): pushed by the VIS thread, taken by the LIS thread before
+  // each measurement. States that arrive after their sweep was fused are simply not used for it (late is late).
+  std::mutex visual_mutex;
+  std::vector<VisualState> visual_states;
+  VisualStateStream visual_stream;  // VIS thread only
+
   LiveQueue<Measurement> lis_queue;
   LiveQueue<VisItem> vis_queue;
   // Keyframes for the loop thread, and the newest correction for the LIS (a later one contains the earlier).

@@ -42,9 +42,15 @@ void System::Impl::lisLoop() {
   while (std::optional<Measurement> m = lis_queue.pop()) {
     std::vector<ScanOutcome> outcomes;
     std::vector<std::string> notices;
+    std::vector<VisualState> visual;
+    {
+      std::lock_guard<std::mutex> lock(visual_mutex);
+      visual.swap(visual_states);
+    }
     {
       std::lock_guard<std::mutex> lock(lis_state_mutex);
       applyCorrection();
+      for (const VisualState& v : visual) lis.addVisualState(v);
       outcomes = lis.process(*m);
       notices = takeNotices();
     }
@@ -183,6 +189,10 @@ void System::Impl::visFrame(const CameraFrame& frame) {
   }
   try {
     const vio::VisFrame f = vo->addFrame(frame, pose_at, seed);
+    if (const std::optional<VisualState> v = visual_stream.onFrame(f.estimate); v && config.use_lidar) {
+      std::lock_guard<std::mutex> lock(visual_mutex);
+      visual_states.push_back(*v);
+    }
     if (cb.vis_frame) cb.vis_frame(f);
   } catch (const std::invalid_argument& e) {  // wrong size or type, a stamp not after the previous frame's
     std::size_t n = 0;

@@ -107,6 +107,19 @@ void bindSmoother(YamlSection& s, backend::FixedLagSmootherConfig& c) {
       .bind("max_bias", c.max_bias);
 }
 
+void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
+  s.bind("factor", c.factor)
+      .bind("initial_guess", c.initial_guess)
+      .bind("sigma_position", c.sigma_position)
+      .bind("sigma_position_ratio", c.sigma_position_ratio)
+      .bind("sigma_rotation", c.sigma_rotation)
+      .bind("sigma_rotation_ratio", c.sigma_rotation_ratio)
+      .bind("min_features", c.min_features)
+      .bind("full_features", c.full_features)
+      .bindSeconds("warmup", c.warmup, atLeast(0, "s"))
+      .bindSeconds("max_age", c.max_age, atLeast(0, "s"));
+}
+
 // The binder has already checked the values (bindChoice), with their lines.
 void applyEnums(const EnumStrings& e, pipeline::OdometryConfig& c) {
   c.layout.spin = e.spin == "cw" ? lidar::SpinDirection::kClockwise : lidar::SpinDirection::kCounterClockwise;
@@ -145,7 +158,8 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
         s.bind("distance", c.keyframes.distance).bind("angle", c.keyframes.angle);
       })
       .nested("imu", [&](YamlSection& s) { bindImu(s, c.preintegration); })
-      .nested("smoother", [&](YamlSection& s) { bindSmoother(s, c.smoother); });
+      .nested("smoother", [&](YamlSection& s) { bindSmoother(s, c.smoother); })
+      .nested("vis_fusion", [&](YamlSection& s) { bindVisFusion(s, c.vis_fusion); });
   top.apply(root["odometry"]);
   applyEnums(e, c);
   // The loop closure has its own top-level section; the matcher and submap of its verifier follow the odometry's.

@@ -1,0 +1,114 @@
+#include "pipeline/visual_motion.hpp"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "geometry/so3.hpp"
+
+namespace drover::pipeline {
+
+std::string VisualMotionConfig::validate() const {
+  for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position", sigma_position},
+                                {"sigma_rotation", sigma_rotation},
+                                {"max_age", max_age}})
+    if (!std::isfinite(v) || v <= 0) return fmt::format("{} must be finite and > 0, got {}", name, v);
+  for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position_ratio", sigma_position_ratio},
+                                {"sigma_rotation_ratio", sigma_rotation_ratio},
+                                {"warmup", warmup}})
+    if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
+  if (min_features < 1 || full_features < min_features)
+    return fmt::format("need 0 < min_features <= full_features, got {} and {}", min_features, full_features);
+  return {};
+}
+
+std::optional<VisualState> VisualStateStream::onFrame(const vio::FrameResult& r) {
+  if (r.just_initialized) {
+    ++init_count_;
+    init_time_ = r.t;
+  }
+  if (!r.initialized) return std::nullopt;
+  return VisualState{r.t, r.T_world_imu, r.v_world, r.bias, r.features, init_count_, init_time_};
+}
+
+VisualMotion::VisualMotion(const VisualMotionConfig& config, const imu::PreintegrationConfig& imu)
+    : config_(config), imu_(imu) {
+  if (const std::string err = config.validate(); !err.empty())
+    throw std::invalid_argument("VisualMotionConfig: " + err);
+}
+
+void VisualMotion::add(const VisualState& state) {
+  if (!states_.empty() && state.t <= states_.back().t) return;
+  if (!state.T_world_imu.matrix().allFinite() || !state.v_world.allFinite()) return;
+  states_.push_back(state);
+  while (states_.front().t < state.t - kKept) states_.pop_front();
+}
+
+std::optional<Eigen::Isometry3d> VisualMotion::poseAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
+                                                      std::string* why) const {
+  const auto it = std::upper_bound(states_.begin(), states_.end(), t,
+                                   [](Time x, const VisualState& s) { return x < s.t; });
+  if (it == states_.begin()) {
+    *why = "no VIS state before the sweep";
+    return std::nullopt;
+  }
+  const VisualState& s = *std::prev(it);
+  *used = &s;
+  if (t - s.t > fromSeconds(config_.max_age)) {
+    *why = fmt::format("the VIS's newest state is {:.2f} s old", toSeconds(t - s.t));
+    return std::nullopt;
+  }
+  if (s.t - s.initialized_at < fromSeconds(config_.warmup)) {
+    *why = "the VIS initialised less than warmup ago";
+    return std::nullopt;
+  }
+  if (s.features < config_.min_features) {
+    *why = fmt::format("the VIS solved with {} features (< {})", s.features, config_.min_features);
+    return std::nullopt;
+  }
+  if (s.t == t) return s.T_world_imu;
+  const std::vector<ImuSample> samples = imu.samplesCovering(s.t, t);
+  if (samples.empty() || samples.back().t < t) {
+    *why = "no IMU samples from the VIS state to the sweep";
+    return std::nullopt;
+  }
+  imu::Preintegrator pim(s.bias, imu_);
+  pim.integrateRange(samples, s.t, t);
+  return pim.predict(imu::NavState{s.t, s.T_world_imu, s.v_world}, s.bias).T_world_imu;
+}
+
+std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu::ImuPropagator& imu,
+                                                       std::string* why) const {
+  std::string reason;
+  std::string* w = why != nullptr ? why : &reason;
+  if (!(a < b)) {
+    *w = "the sweep stamps are not increasing";
+    return std::nullopt;
+  }
+  const VisualState* sa = nullptr;
+  const VisualState* sb = nullptr;
+  const std::optional<Eigen::Isometry3d> Ta = poseAt(a, imu, &sa, w);
+  if (!Ta) return std::nullopt;
+  const std::optional<Eigen::Isometry3d> Tb = poseAt(b, imu, &sb, w);
+  if (!Tb) return std::nullopt;
+  if (sa->reset_id != sb->reset_id) {
+    *w = "the VIS reset between the sweeps";
+    return std::nullopt;
+  }
+  VisualIncrement inc;
+  inc.T_a_b = Ta->inverse() * *Tb;
+  // Fewer features than a full frame: the sigmas grow as 1/sqrt(n), as a mean over n independent features would.
+  const int n = std::min(sa->features, sb->features);
+  const double scale = std::sqrt(static_cast<double>(config_.full_features) / std::min(n, config_.full_features));
+  const double moved = inc.T_a_b.translation().norm();
+  const double turned = geometry::logSO3(inc.T_a_b.linear()).norm();
+  const double sp = scale * (config_.sigma_position + config_.sigma_position_ratio * moved);
+  const double sr = scale * (config_.sigma_rotation + config_.sigma_rotation_ratio * turned);
+  inc.sqrt_information.setZero();
+  inc.sqrt_information.diagonal() << Eigen::Vector3d::Constant(1 / sp), Eigen::Vector3d::Constant(1 / sr);
+  return inc;
+}
+
+}  // namespace drover::pipeline

@@ -1,0 +1,96 @@
+#pragma once
+// The VIS's motion as the LIS uses it (LVI-SAM, Shan et al. ICRA 2021, Sec. III-B-1 and III-C): the VIS publishes
+// its newest state at every camera frame, and the LIS asks for the VIS's motion between two sweep stamps -- the
+// scan matcher's initial guess (LVI-SAM's updateInitialGuess) and a relative-pose factor in the LIS's IMU smoother
+// (the paper's visual odometry factor, which LVI-SAM's released code leaves out). The VIS pose at a sweep stamp is
+// its newest published state at or before the stamp, carried to it by the IMU with that state's velocity and
+// biases (a camera frame is at most 1/rate before it). Increments are differences of published poses, so chained
+// over a run they telescope to the VIS's own trajectory: the fusion adds no drift of its own.
+// A VIS state is used only while the VIS is healthy: initialised for `warmup`, enough features in its solve, the
+// same reset ID (LVI-SAM's) at both ends, and a state no older than `max_age` at the stamp (a camera blackout).
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+
+#include "imu/preintegration.hpp"
+#include "imu/propagator.hpp"
+#include "types/time.hpp"
+#include "vio/sliding_window.hpp"
+
+namespace drover::pipeline {
+
+struct VisualMotionConfig {
+  bool factor = true;          // the VIS's motion as a relative-pose factor in the LIS's IMU smoother
+  bool initial_guess = true;   // the VIS's motion as the scan matcher's initial guess (else the IMU's)
+  // The factor's sigmas over one sweep interval, in the earlier sweep's IMU frame: a floor plus a share of the
+  // motion (the VIS's own drift is 0.3-1.6 % of its path on the simulated courses, its per-frame jitter ~1 cm).
+  double sigma_position = 0.02;        // [m]
+  double sigma_position_ratio = 0.05;  // [m per m moved]
+  double sigma_rotation = 0.01;        // [rad]
+  double sigma_rotation_ratio = 0.05;  // [rad per rad turned]
+  int min_features = 20;    // [-] a VIS state with fewer features in its solve is not used
+  int full_features = 80;   // [-] below this many the sigmas grow as sqrt(full_features / features)
+  double warmup = 1.0;      // [s] after the VIS (re)initialises its states are not used for this long
+  double max_age = 0.2;     // [s] the newest VIS state before a sweep stamp must be at most this old
+  // Empty when valid: sigmas and ratios finite (sigmas > 0, ratios >= 0), 0 < min_features <= full_features,
+  // warmup >= 0, max_age > 0.
+  std::string validate() const;
+};
+
+// The VIS's newest state after one camera frame (VisualOdometry's FrameResult), in the VIS's world frame.
+struct VisualState {
+  Time t = 0;                                                     // [ns] IMU time of the frame
+  Eigen::Isometry3d T_world_imu = Eigen::Isometry3d::Identity();
+  Eigen::Vector3d v_world = Eigen::Vector3d::Zero();              // [m/s]
+  imu::ImuBias bias;
+  int features = 0;           // features in the frame's solve
+  std::uint32_t reset_id = 0; // the VIS's (re)initialisation count: states of different IDs are not related
+  Time initialized_at = 0;    // [ns] when the VIS last (re)initialised
+};
+
+// The VIS's per-frame results as VisualStates, its (re)initialisations numbered (LVI-SAM's reset ID). Shared by
+// the replay (apps/drover/run_vis.cpp) and the live system.
+class VisualStateStream {
+ public:
+  // The state after this frame, or nothing when the VIS has no estimate at it.
+  std::optional<VisualState> onFrame(const vio::FrameResult& r);
+
+ private:
+  std::uint32_t init_count_ = 0;
+  Time init_time_ = 0;
+};
+
+// The VIS's motion T_a_b = T_world_imu(a)^-1 T_world_imu(b) with the square-root information of its error
+// [dp in frame a (m); dtheta (rad)], as backend::RelativePoseMeasurement takes it.
+struct VisualIncrement {
+  Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity();
+  Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
+};
+
+class VisualMotion {
+ public:
+  // Throws std::invalid_argument when config.validate() fails.
+  VisualMotion(const VisualMotionConfig& config, const imu::PreintegrationConfig& imu);
+
+  // States in time order; one not after the newest is ignored. Keeps the last kKept seconds.
+  void add(const VisualState& state);
+  // The VIS's motion between stamps a < b, carried by the buffered IMU samples of `imu`; nullopt with `why` set
+  // when the VIS cannot give it (no state, unhealthy, a reset between, no IMU cover).
+  std::optional<VisualIncrement> increment(Time a, Time b, const imu::ImuPropagator& imu, std::string* why) const;
+  const VisualMotionConfig& config() const { return config_; }
+  bool empty() const { return states_.empty(); }
+
+  static constexpr Time kKept = 5'000'000'000;  // [ns]
+
+ private:
+  // The VIS's pose at t: the newest usable state at or before t, propagated to t.
+  std::optional<Eigen::Isometry3d> poseAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
+                                          std::string* why) const;
+  VisualMotionConfig config_;
+  imu::PreintegrationConfig imu_;
+  std::deque<VisualState> states_;
+};
+
+}  // namespace drover::pipeline

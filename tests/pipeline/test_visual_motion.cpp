@@ -1,0 +1,187 @@
+// The VIS's motion as the LIS takes it (pipeline::VisualMotion): the pose at a sweep stamp from the VIS's newest
+// state before it carried by the IMU, the increment between two stamps against an analytic trajectory, and every
+// health gate (warm-up, features, age, reset ID) with its reason.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "geometry/so3.hpp"
+#include "pipeline/visual_motion.hpp"
+#include "sim/imu_model.hpp"
+#include "sim/trajectory.hpp"
+
+namespace drover::pipeline {
+namespace {
+
+constexpr Time kSec = 1'000'000'000;
+constexpr Time kFrame = kSec / 15;  // 15 Hz camera
+
+// 8 s turning, climbing and accelerating (knots every 0.5 s).
+sim::SplineTrajectory turningPath() {
+  std::vector<sim::PathSample> samples;
+  for (int k = 0; k <= 16; ++k) {
+    const double t = 0.5 * k;
+    sim::PathSample s;
+    s.t = k * kSec / 2;
+    s.p_world = {1.5 * t + 0.1 * t * t, 2.0 * std::sin(0.4 * t), 0.2 * std::sin(0.5 * t)};
+    s.yaw = 0.3 * t + 0.4 * std::sin(0.6 * t);
+    s.pitch = 0.03 * std::sin(0.8 * t);
+    s.roll = 0.04 * std::cos(0.7 * t);
+    samples.push_back(s);
+  }
+  return sim::SplineTrajectory(samples);
+}
+
+struct Course {
+  sim::SplineTrajectory path = turningPath();
+  std::vector<ImuSample> imu;
+  imu::PreintegrationConfig preintegration;
+  Course() {
+    sim::ImuModelConfig m;  // noiseless and unbiased: the propagation is then exact up to discretisation
+    m.gyro_noise_density = m.accel_noise_density = 0;
+    m.gyro_bias_random_walk = m.accel_bias_random_walk = 0;
+    m.initial_gyro_bias.setZero();
+    m.initial_accel_bias.setZero();
+    imu = sim::simulateImu(path, m, 3);
+  }
+  // The propagator as the LIS holds it: every sample up to `until`.
+  imu::ImuPropagator propagator(Time until) const {
+    imu::ImuPropagator p;
+    for (const ImuSample& s : imu)
+      if (s.t <= until) p.addSample(s);
+    return p;
+  }
+  VisualState state(Time t, int features = 120, std::uint32_t reset_id = 1, Time initialized_at = 0) const {
+    const sim::BodyState b = path.at(t);
+    return VisualState{t, b.T_world_body, b.v_world, imu::ImuBias{}, features, reset_id, initialized_at};
+  }
+};
+
+const Course& course() {
+  static const Course c;
+  return c;
+}
+
+VisualMotion motionWithFrames(Time until, const VisualMotionConfig& config = {}) {
+  VisualMotion m(config, course().preintegration);
+  for (Time t = 0; t <= until; t += kFrame) m.add(course().state(t));
+  return m;
+}
+
+}  // namespace
+
+TEST(VisualMotion, TheIncrementBetweenTwoSweepStampsIsTheTrueMotionCarriedFromTheFramesBeforeThem) {
+  // Sweeps at 10 Hz between 15 Hz frames: each end is up to 67 ms after its frame.
+  const Time a = 5 * kSec + 30'000'000, b = a + kSec / 10;
+  const VisualMotion m = motionWithFrames(b + 20'000'000);
+  std::string why;
+  const std::optional<VisualIncrement> inc = m.increment(a, b, course().propagator(b + 20'000'000), &why);
+  ASSERT_TRUE(inc) << why;
+  const Eigen::Isometry3d truth = course().path.at(a).T_world_body.inverse() * course().path.at(b).T_world_body;
+  const double dp = (inc->T_a_b.translation() - truth.translation()).norm();
+  const double dr = geometry::logSO3(truth.linear().transpose() * inc->T_a_b.linear()).norm();
+  std::printf("increment over %.3f m: |dp| %.2e m, |dtheta| %.2e rad\n", truth.translation().norm(), dp, dr);
+  EXPECT_GT(truth.translation().norm(), 0.1);
+  EXPECT_LT(dp, 1e-4);
+  EXPECT_LT(dr, 1e-5);
+  // The sigma is the floor plus the share of the motion, on the translation and the rotation.
+  const VisualMotionConfig c;
+  const double turned = geometry::logSO3(truth.linear()).norm();
+  EXPECT_NEAR(1 / inc->sqrt_information(0, 0), c.sigma_position + c.sigma_position_ratio * truth.translation().norm(),
+              1e-5);
+  EXPECT_NEAR(1 / inc->sqrt_information(4, 4), c.sigma_rotation + c.sigma_rotation_ratio * turned, 1e-6);
+}
+
+TEST(VisualMotion, FewerFeaturesThanAFullFrameWidenTheSigmasAsOneOverTheSquareRoot) {
+  const VisualMotionConfig c;  // full_features 80
+  VisualMotion full(c, course().preintegration), quarter(c, course().preintegration);
+  for (Time t = 0; t <= 3 * kSec; t += kFrame) {
+    full.add(course().state(t, 80));
+    quarter.add(course().state(t, 20));
+  }
+  const imu::ImuPropagator imu = course().propagator(3 * kSec);
+  const auto a = full.increment(2 * kSec, 2 * kSec + kSec / 10, imu, nullptr);
+  const auto b = quarter.increment(2 * kSec, 2 * kSec + kSec / 10, imu, nullptr);
+  ASSERT_TRUE(a && b);
+  EXPECT_NEAR(a->sqrt_information(0, 0) / b->sqrt_information(0, 0), 2.0, 1e-9);
+  EXPECT_NEAR(a->sqrt_information(3, 3) / b->sqrt_information(3, 3), 2.0, 1e-9);
+}
+
+TEST(VisualMotion, AnUnhealthyVisGivesNoMotionAndSaysWhy) {
+  const imu::ImuPropagator imu = course().propagator(4 * kSec);
+  const Time a = 3 * kSec, b = a + kSec / 10;
+  std::string why;
+  {  // nothing before the first stamp
+    VisualMotion m({}, course().preintegration);
+    m.add(course().state(b + kFrame));
+    EXPECT_FALSE(m.increment(a, b, imu, &why));
+    EXPECT_NE(why.find("no VIS state"), std::string::npos) << why;
+  }
+  {  // a camera blackout: the newest state is 0.5 s old
+    VisualMotion m({}, course().preintegration);
+    for (Time t = 0; t <= a - kSec / 2; t += kFrame) m.add(course().state(t));
+    EXPECT_FALSE(m.increment(a, b, imu, &why));
+    EXPECT_NE(why.find("old"), std::string::npos) << why;
+  }
+  {  // too few features in the solve
+    VisualMotion m({}, course().preintegration);
+    for (Time t = 0; t <= b; t += kFrame) m.add(course().state(t, 12));
+    EXPECT_FALSE(m.increment(a, b, imu, &why));
+    EXPECT_NE(why.find("12 features"), std::string::npos) << why;
+  }
+  {  // initialised 0.5 s before: still warming up
+    VisualMotion m({}, course().preintegration);
+    for (Time t = 0; t <= b; t += kFrame) m.add(course().state(t, 120, 1, a - kSec / 2));
+    EXPECT_FALSE(m.increment(a, b, imu, &why));
+    EXPECT_NE(why.find("warmup"), std::string::npos) << why;
+  }
+  {  // a reset between the two stamps (LVI-SAM's reset ID): the two poses are of different windows
+    VisualMotion m({}, course().preintegration);
+    for (Time t = 0; t <= b; t += kFrame) m.add(course().state(t, 120, t < a + kSec / 20 ? 1 : 2, 0));
+    EXPECT_FALSE(m.increment(a, b, imu, &why));
+    EXPECT_NE(why.find("reset"), std::string::npos) << why;
+  }
+  {  // and the healthy control
+    const VisualMotion m = motionWithFrames(b);
+    EXPECT_TRUE(m.increment(a, b, imu, &why)) << why;
+  }
+}
+
+TEST(VisualMotion, TheStateStreamNumbersTheVisInitialisationsAndSkipsFramesWithoutAnEstimate) {
+  VisualStateStream stream;
+  vio::FrameResult r;
+  r.t = 10;
+  EXPECT_FALSE(stream.onFrame(r));  // waiting for initialisation
+  r.t = 20, r.initialized = r.just_initialized = true, r.features = 90;
+  std::optional<VisualState> s = stream.onFrame(r);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->reset_id, 1u);
+  EXPECT_EQ(s->initialized_at, 20);
+  EXPECT_EQ(s->features, 90);
+  r.t = 30, r.just_initialized = false;
+  EXPECT_EQ(stream.onFrame(r)->reset_id, 1u);
+  r.t = 40, r.initialized = false, r.reset = true;  // a failure cleared the window
+  EXPECT_FALSE(stream.onFrame(r));
+  r.t = 50, r.initialized = r.just_initialized = true, r.reset = false;
+  s = stream.onFrame(r);
+  EXPECT_EQ(s->reset_id, 2u);
+  EXPECT_EQ(s->initialized_at, 50);
+}
+
+TEST(VisualMotion, InvalidSettingsAreRefusedNamingTheKey) {
+  VisualMotionConfig c;
+  c.sigma_position = 0;
+  EXPECT_NE(c.validate().find("sigma_position"), std::string::npos);
+  c = {};
+  c.min_features = 100;  // above full_features
+  EXPECT_NE(c.validate().find("min_features"), std::string::npos);
+  c = {};
+  c.max_age = std::nan("");
+  EXPECT_NE(c.validate().find("max_age"), std::string::npos);
+  EXPECT_THROW(VisualMotion(c, imu::PreintegrationConfig{}), std::invalid_argument);
+  EXPECT_TRUE(VisualMotionConfig{}.validate().empty());
+}
+
+}  // namespace drover::pipeline
