@@ -160,7 +160,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   std::optional<backend::RelativePoseMeasurement> visual;
   if (config_.vis_fusion.factor && !visual_.empty()) {
     std::string why;
-    if (const std::optional<VisualIncrement> inc = visual_.increment(previous.t, out.t, propagator_, &why)) {
+    if (const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, out.t, &why)) {
       visual = backend::RelativePoseMeasurement{inc->T_a_b, inc->sqrt_information};
       out.vis_factor = true;
     } else {
@@ -200,9 +200,23 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
 std::optional<Eigen::Isometry3d> ImuFusion::visualLidarGuess(Time t, const StampedPose& previous,
                                                               std::string* why) const {
   if (!config_.vis_fusion.initial_guess || visual_.empty() || !initialized_) return std::nullopt;
-  const std::optional<VisualIncrement> inc = visual_.increment(previous.t, t, propagator_, why);
+  const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, t, why);
   if (!inc) return std::nullopt;
   return previous.T_world_body * T_lidar_imu_ * inc->T_a_b * T_imu_lidar_;
+}
+
+// The VIS's motion between a and b while it agrees with the IMU's prediction from the newest fused state (the
+// propagation starts there; a is that state's stamp).
+std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b, std::string* why) const {
+  std::optional<VisualIncrement> inc = visual_.increment(a, b, propagator_, why);
+  if (!inc) return std::nullopt;
+  const std::optional<imu::NavState> xa = propagator_.stateAt(a), xb = propagator_.stateAt(b);
+  if (!xa || !xb) return inc;  // no prediction to hold it against (the smoother restarts)
+  if (std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion); !d.empty()) {
+    if (why != nullptr) *why = std::move(d);
+    return std::nullopt;
+  }
+  return inc;
 }
 
 // Sigma of the lidar pose: lidar_sigma_position/rotation, plus degenerate_sigma along each degenerate direction of

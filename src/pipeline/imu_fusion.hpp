@@ -79,6 +79,7 @@ class ImuFusion {
   void restart(const imu::NavState& state, const imu::ImuBias& bias,
                const std::optional<Eigen::Matrix3d>& gyro_bias_covariance = std::nullopt,
                const std::optional<Eigen::Matrix<double, 6, 6>>& bias_covariance = std::nullopt);
+  std::optional<VisualIncrement> checkedVisualIncrement(Time a, Time b, std::string* why) const;
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
 
   OdometryConfig config_;

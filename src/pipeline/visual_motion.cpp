@@ -19,6 +19,10 @@ std::string VisualMotionConfig::validate() const {
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
                                 {"warmup", warmup}})
     if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
+  if (!(max_velocity_difference > 0) || !(max_position_difference > 0) || !std::isfinite(max_velocity_difference) ||
+      !std::isfinite(max_position_difference))
+    return fmt::format("max_velocity_difference and max_position_difference must be finite and > 0, got {} and {}",
+                       max_velocity_difference, max_position_difference);
   if (min_features < 1 || full_features < min_features)
     return fmt::format("need 0 < min_features <= full_features, got {} and {}", min_features, full_features);
   return {};
@@ -46,8 +50,8 @@ void VisualMotion::add(const VisualState& state) {
   while (states_.front().t < state.t - kKept) states_.pop_front();
 }
 
-std::optional<Eigen::Isometry3d> VisualMotion::poseAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
-                                                      std::string* why) const {
+std::optional<imu::NavState> VisualMotion::stateAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
+                                                  std::string* why) const {
   const auto it = std::upper_bound(states_.begin(), states_.end(), t,
                                    [](Time x, const VisualState& s) { return x < s.t; });
   if (it == states_.begin()) {
@@ -68,7 +72,7 @@ std::optional<Eigen::Isometry3d> VisualMotion::poseAt(Time t, const imu::ImuProp
     *why = fmt::format("the VIS solved with {} features (< {})", s.features, config_.min_features);
     return std::nullopt;
   }
-  if (s.t == t) return s.T_world_imu;
+  if (s.t == t) return imu::NavState{s.t, s.T_world_imu, s.v_world};
   const std::vector<ImuSample> samples = imu.samplesCovering(s.t, t);
   if (samples.empty() || samples.back().t < t) {
     *why = "no IMU samples from the VIS state to the sweep";
@@ -76,7 +80,7 @@ std::optional<Eigen::Isometry3d> VisualMotion::poseAt(Time t, const imu::ImuProp
   }
   imu::Preintegrator pim(s.bias, imu_);
   pim.integrateRange(samples, s.t, t);
-  return pim.predict(imu::NavState{s.t, s.T_world_imu, s.v_world}, s.bias).T_world_imu;
+  return pim.predict(imu::NavState{s.t, s.T_world_imu, s.v_world}, s.bias);
 }
 
 std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu::ImuPropagator& imu,
@@ -89,16 +93,17 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   }
   const VisualState* sa = nullptr;
   const VisualState* sb = nullptr;
-  const std::optional<Eigen::Isometry3d> Ta = poseAt(a, imu, &sa, w);
-  if (!Ta) return std::nullopt;
-  const std::optional<Eigen::Isometry3d> Tb = poseAt(b, imu, &sb, w);
-  if (!Tb) return std::nullopt;
+  const std::optional<imu::NavState> xa = stateAt(a, imu, &sa, w);
+  if (!xa) return std::nullopt;
+  const std::optional<imu::NavState> xb = stateAt(b, imu, &sb, w);
+  if (!xb) return std::nullopt;
   if (sa->reset_id != sb->reset_id) {
     *w = "the VIS reset between the sweeps";
     return std::nullopt;
   }
   VisualIncrement inc;
-  inc.T_a_b = Ta->inverse() * *Tb;
+  inc.T_a_b = xa->T_world_imu.inverse() * xb->T_world_imu;
+  inc.v_b = xb->T_world_imu.linear().transpose() * xb->v_world;
   // Fewer features than a full frame: the sigmas grow as 1/sqrt(n), as a mean over n independent features would.
   const int n = std::min(sa->features, sb->features);
   const double scale = std::sqrt(static_cast<double>(config_.full_features) / std::min(n, config_.full_features));
@@ -109,6 +114,24 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   inc.sqrt_information.setZero();
   inc.sqrt_information.diagonal() << Eigen::Vector3d::Constant(1 / sp), Eigen::Vector3d::Constant(1 / sr);
   return inc;
+}
+
+}  // namespace drover::pipeline
+
+namespace drover::pipeline {
+
+std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
+                                const VisualMotionConfig& config) {
+  const Eigen::Vector3d v_b_imu = b.T_world_imu.linear().transpose() * b.v_world;
+  const double dv = (inc.v_b - v_b_imu).norm();
+  if (dv > config.max_velocity_difference)
+    return fmt::format("the VIS's velocity differs from the IMU's prediction by {:.2f} m/s", dv);
+  const Eigen::Vector3d dp_imu = a.T_world_imu.linear().transpose() * (b.T_world_imu.translation() -
+                                                                       a.T_world_imu.translation());
+  const double dp = (inc.T_a_b.translation() - dp_imu).norm();
+  if (dp > config.max_position_difference)
+    return fmt::format("the VIS's motion differs from the IMU's prediction by {:.2f} m", dp);
+  return {};
 }
 
 }  // namespace drover::pipeline

@@ -34,6 +34,12 @@ struct VisualMotionConfig {
   int full_features = 80;   // [-] below this many the sigmas grow as sqrt(full_features / features)
   double warmup = 1.0;      // [s] after the VIS (re)initialises its states are not used for this long
   double max_age = 0.2;     // [s] the newest VIS state before a sweep stamp must be at most this old
+  // A VIS that lost its features can stall (white walls: it held still for 3 s while the robot drove 2.7 m on,
+  // then jumped 3 m back to the truth). Its motion is refused while it disagrees with the LIS's own IMU prediction
+  // of the same sweep interval (the fused state propagated): by more than this in body-frame velocity at the
+  // later stamp, or in the translation between the stamps.
+  double max_velocity_difference = 0.3;  // [m/s]
+  double max_position_difference = 0.15; // [m]
   // Empty when valid: sigmas and ratios finite (sigmas > 0, ratios >= 0), 0 < min_features <= full_features,
   // warmup >= 0, max_age > 0.
   std::string validate() const;
@@ -67,7 +73,13 @@ class VisualStateStream {
 struct VisualIncrement {
   Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity();
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
+  Eigen::Vector3d v_b = Eigen::Vector3d::Zero();  // [m/s] the VIS's velocity at b in the IMU frame at b
 };
+
+// Empty when the increment agrees with the IMU's prediction of the same interval (states at a and b, world frame
+// of their own) within config.max_velocity_difference and max_position_difference, else why not.
+std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
+                                const VisualMotionConfig& config);
 
 class VisualMotion {
  public:
@@ -85,9 +97,9 @@ class VisualMotion {
   static constexpr Time kKept = 5'000'000'000;  // [ns]
 
  private:
-  // The VIS's pose at t: the newest usable state at or before t, propagated to t.
-  std::optional<Eigen::Isometry3d> poseAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
-                                          std::string* why) const;
+  // The VIS's state at t: the newest usable state at or before t, propagated to t.
+  std::optional<imu::NavState> stateAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
+                                      std::string* why) const;
   VisualMotionConfig config_;
   imu::PreintegrationConfig imu_;
   std::deque<VisualState> states_;

@@ -185,3 +185,28 @@ TEST(VisualMotion, InvalidSettingsAreRefusedNamingTheKey) {
 }
 
 }  // namespace drover::pipeline
+
+namespace drover::pipeline {
+
+TEST(VisualMotion, AStalledVisDisagreesWithTheImuPredictionAndIsRefusedAConsistentOneIsKept) {
+  // The LIS's prediction: 1 m/s along its body x for 0.1 s, in a world turned 90 deg (the check is frame-free).
+  const Eigen::Isometry3d T_a(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
+  Eigen::Isometry3d T_b = T_a;
+  T_b.translation() = T_a * Eigen::Vector3d(0.1, 0, 0);
+  const imu::NavState a{0, T_a, T_a.linear() * Eigen::Vector3d(1, 0, 0)};
+  const imu::NavState b{kSec / 10, T_b, a.v_world};
+  const VisualMotionConfig c;  // 0.3 m/s, 0.15 m
+  VisualIncrement agree;
+  agree.T_a_b.translation() = Eigen::Vector3d(0.1, 0.01, 0);
+  agree.v_b = {1.05, 0, 0};
+  EXPECT_EQ(disagreementWithImu(agree, a, b, c), "");
+  VisualIncrement stalled = agree;  // white walls: the VIS holds still while the robot drives on
+  stalled.v_b = {0.05, 0, 0};
+  stalled.T_a_b.translation() = Eigen::Vector3d(0.005, 0, 0);
+  EXPECT_NE(disagreementWithImu(stalled, a, b, c).find("velocity"), std::string::npos);
+  VisualIncrement jumped = agree;  // its catch-up: 3 m in a few frames, at a plausible velocity
+  jumped.T_a_b.translation() = Eigen::Vector3d(0.9, 0, 0);
+  EXPECT_NE(disagreementWithImu(jumped, a, b, c).find("motion"), std::string::npos);
+}
+
+}  // namespace drover::pipeline

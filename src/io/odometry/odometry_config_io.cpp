@@ -117,7 +117,9 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bind("min_features", c.min_features)
       .bind("full_features", c.full_features)
       .bindSeconds("warmup", c.warmup, atLeast(0, "s"))
-      .bindSeconds("max_age", c.max_age, atLeast(0, "s"));
+      .bindSeconds("max_age", c.max_age, atLeast(0, "s"))
+      .bind("max_velocity_difference", c.max_velocity_difference)
+      .bind("max_position_difference", c.max_position_difference);
 }
 
 // The binder has already checked the values (bindChoice), with their lines.
