@@ -92,6 +92,10 @@ Json SweepLog::line(const pipeline::ScanOutcome& s) {
             {"imu", s.imu_used},
             {"reset", s.reset},
             {"total_ms", s.ms.total}};
+  // With a VIS: whether its motion was the matcher's guess and a smoother factor, or why it was not used.
+  if (s.vis_guess) j["vis_guess"] = true;
+  if (s.vis_factor) j["vis_factor"] = true;
+  if (!s.vis_unused.empty()) j["vis_unused"] = s.vis_unused;
   if (s.has_imu_state) {
     j["v_world"] = vectorJson(s.v_world);      // [m/s]
     j["gyro_bias"] = vectorJson(s.gyro_bias);  // [rad/s], IMU frame
