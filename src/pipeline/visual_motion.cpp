@@ -19,6 +19,10 @@ std::string VisualMotionConfig::validate() const {
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
                                 {"warmup", warmup}})
     if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
+  if (!(max_keyframe_gap > 0) || !std::isfinite(max_keyframe_gap) || !(standing_speed >= 0) ||
+      !std::isfinite(standing_speed))
+    return fmt::format("max_keyframe_gap must be finite and > 0 and standing_speed >= 0, got {} and {}",
+                       max_keyframe_gap, standing_speed);
   if (!(max_velocity_difference > 0) || !(max_position_difference > 0) || !std::isfinite(max_velocity_difference) ||
       !std::isfinite(max_position_difference))
     return fmt::format("max_velocity_difference and max_position_difference must be finite and > 0, got {} and {}",
@@ -31,10 +35,11 @@ std::string VisualMotionConfig::validate() const {
 std::optional<VisualState> VisualStateStream::onFrame(const vio::FrameResult& r) {
   if (r.just_initialized) {
     ++init_count_;
-    init_time_ = r.t;
+    init_time_ = keyframe_time_ = r.t;
   }
   if (!r.initialized) return std::nullopt;
-  return VisualState{r.t, r.T_world_imu, r.v_world, r.bias, r.features, init_count_, init_time_};
+  if (r.keyframe) keyframe_time_ = r.t;
+  return VisualState{r.t, r.T_world_imu, r.v_world, r.bias, r.features, init_count_, init_time_, keyframe_time_};
 }
 
 VisualMotion::VisualMotion(const VisualMotionConfig& config, const imu::PreintegrationConfig& imu)
@@ -104,6 +109,7 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   VisualIncrement inc;
   inc.T_a_b = xa->T_world_imu.inverse() * xb->T_world_imu;
   inc.v_b = xb->T_world_imu.linear().transpose() * xb->v_world;
+  inc.last_keyframe_at = sb->last_keyframe_at;
   // Fewer features than a full frame: the sigmas grow as 1/sqrt(n), as a mean over n independent features would.
   const int n = std::min(sa->features, sb->features);
   const double scale = std::sqrt(static_cast<double>(config_.full_features) / std::min(n, config_.full_features));
@@ -123,6 +129,9 @@ namespace drover::pipeline {
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
                                 const VisualMotionConfig& config) {
   const Eigen::Vector3d v_b_imu = b.T_world_imu.linear().transpose() * b.v_world;
+  const double gap = toSeconds(b.t - inc.last_keyframe_at);
+  if (gap > config.max_keyframe_gap && v_b_imu.norm() > config.standing_speed)
+    return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s", gap, v_b_imu.norm());
   const double dv = (inc.v_b - v_b_imu).norm();
   if (dv > config.max_velocity_difference)
     return fmt::format("the VIS's velocity differs from the IMU's prediction by {:.2f} m/s", dv);

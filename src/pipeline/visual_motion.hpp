@@ -34,12 +34,16 @@ struct VisualMotionConfig {
   int full_features = 80;   // [-] below this many the sigmas grow as sqrt(full_features / features)
   double warmup = 1.0;      // [s] after the VIS (re)initialises its states are not used for this long
   double max_age = 0.2;     // [s] the newest VIS state before a sweep stamp must be at most this old
-  // A VIS that lost its features can stall (white walls: it held still for 3 s while the robot drove 2.7 m on,
-  // then jumped 3 m back to the truth). Its motion is refused while it disagrees with the LIS's own IMU prediction
-  // of the same sweep interval (the fused state propagated): by more than this in body-frame velocity at the
-  // later stamp, or in the translation between the stamps.
-  double max_velocity_difference = 0.3;  // [m/s]
-  double max_position_difference = 0.15; // [m]
+  // A VIS that lost its features can stall: on the farm's white walls it made no keyframe for 35 s (its window
+  // kept the old ones), held still for 3 s while the robot drove 2.7 m on, then jumped 3 m back to the truth.
+  // While the LIS's IMU prediction says the robot moves faster than `standing_speed`, a VIS whose last keyframe is
+  // older than `max_keyframe_gap` is not used (standing still, no keyframe is due). Gating on the LIS's own
+  // velocity instead caught the stall only after it had dragged that velocity down, then locked the recovered VIS
+  // out. Gross disagreement with the IMU prediction of the sweep interval (the catch-up jump) is refused too.
+  double max_keyframe_gap = 2.0;          // [s]
+  double standing_speed = 0.2;            // [m/s]
+  double max_velocity_difference = 1.0;   // [m/s] body-frame velocity at the later stamp
+  double max_position_difference = 0.5;   // [m] translation between the stamps
   // Empty when valid: sigmas and ratios finite (sigmas > 0, ratios >= 0), 0 < min_features <= full_features,
   // warmup >= 0, max_age > 0.
   std::string validate() const;
@@ -54,6 +58,7 @@ struct VisualState {
   int features = 0;           // features in the frame's solve
   std::uint32_t reset_id = 0; // the VIS's (re)initialisation count: states of different IDs are not related
   Time initialized_at = 0;    // [ns] when the VIS last (re)initialised
+  Time last_keyframe_at = 0;  // [ns] the VIS's newest keyframe (its initialisation when none since)
 };
 
 // The VIS's per-frame results as VisualStates, its (re)initialisations numbered (LVI-SAM's reset ID). Shared by
@@ -65,7 +70,7 @@ class VisualStateStream {
 
  private:
   std::uint32_t init_count_ = 0;
-  Time init_time_ = 0;
+  Time init_time_ = 0, keyframe_time_ = 0;
 };
 
 // The VIS's motion T_a_b = T_world_imu(a)^-1 T_world_imu(b) with the square-root information of its error
@@ -74,10 +79,12 @@ struct VisualIncrement {
   Eigen::Isometry3d T_a_b = Eigen::Isometry3d::Identity();
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
   Eigen::Vector3d v_b = Eigen::Vector3d::Zero();  // [m/s] the VIS's velocity at b in the IMU frame at b
+  Time last_keyframe_at = 0;                      // [ns] of the VIS state used at b
 };
 
 // Empty when the increment agrees with the IMU's prediction of the same interval (states at a and b, world frame
-// of their own) within config.max_velocity_difference and max_position_difference, else why not.
+// of their own) within config.max_velocity_difference and max_position_difference, and the VIS made a keyframe
+// within max_keyframe_gap of b unless the prediction stands still; else why not.
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
                                 const VisualMotionConfig& config);
 

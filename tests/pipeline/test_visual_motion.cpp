@@ -55,7 +55,7 @@ struct Course {
   }
   VisualState state(Time t, int features = 120, std::uint32_t reset_id = 1, Time initialized_at = 0) const {
     const sim::BodyState b = path.at(t);
-    return VisualState{t, b.T_world_body, b.v_world, imu::ImuBias{}, features, reset_id, initialized_at};
+    return VisualState{t, b.T_world_body, b.v_world, imu::ImuBias{}, features, reset_id, initialized_at, t};
   }
 };
 
@@ -160,8 +160,11 @@ TEST(VisualMotion, TheStateStreamNumbersTheVisInitialisationsAndSkipsFramesWitho
   EXPECT_EQ(s->reset_id, 1u);
   EXPECT_EQ(s->initialized_at, 20);
   EXPECT_EQ(s->features, 90);
-  r.t = 30, r.just_initialized = false;
+  EXPECT_EQ(s->last_keyframe_at, 20);
+  r.t = 30, r.just_initialized = false, r.keyframe = true;
   EXPECT_EQ(stream.onFrame(r)->reset_id, 1u);
+  r.t = 35, r.keyframe = false;
+  EXPECT_EQ(stream.onFrame(r)->last_keyframe_at, 30);
   r.t = 40, r.initialized = false, r.reset = true;  // a failure cleared the window
   EXPECT_FALSE(stream.onFrame(r));
   r.t = 50, r.initialized = r.just_initialized = true, r.reset = false;
@@ -188,25 +191,37 @@ TEST(VisualMotion, InvalidSettingsAreRefusedNamingTheKey) {
 
 namespace drover::pipeline {
 
-TEST(VisualMotion, AStalledVisDisagreesWithTheImuPredictionAndIsRefusedAConsistentOneIsKept) {
+TEST(VisualMotion, AStalledOrJumpingVisIsRefusedAHealthyOrStandingOneIsKept) {
   // The LIS's prediction: 1 m/s along its body x for 0.1 s, in a world turned 90 deg (the check is frame-free).
   const Eigen::Isometry3d T_a(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
   Eigen::Isometry3d T_b = T_a;
   T_b.translation() = T_a * Eigen::Vector3d(0.1, 0, 0);
-  const imu::NavState a{0, T_a, T_a.linear() * Eigen::Vector3d(1, 0, 0)};
-  const imu::NavState b{kSec / 10, T_b, a.v_world};
-  const VisualMotionConfig c;  // 0.3 m/s, 0.15 m
-  VisualIncrement agree;
-  agree.T_a_b.translation() = Eigen::Vector3d(0.1, 0.01, 0);
-  agree.v_b = {1.05, 0, 0};
-  EXPECT_EQ(disagreementWithImu(agree, a, b, c), "");
-  VisualIncrement stalled = agree;  // white walls: the VIS holds still while the robot drives on
-  stalled.v_b = {0.05, 0, 0};
-  stalled.T_a_b.translation() = Eigen::Vector3d(0.005, 0, 0);
-  EXPECT_NE(disagreementWithImu(stalled, a, b, c).find("velocity"), std::string::npos);
-  VisualIncrement jumped = agree;  // its catch-up: 3 m in a few frames, at a plausible velocity
+  const Time t_b = 10 * kSec;
+  const imu::NavState a{t_b - kSec / 10, T_a, T_a.linear() * Eigen::Vector3d(1, 0, 0)};
+  const imu::NavState b{t_b, T_b, a.v_world};
+  const VisualMotionConfig c;  // keyframe gap 2 s, standing 0.2 m/s, 1 m/s, 0.5 m
+  VisualIncrement healthy;
+  healthy.T_a_b.translation() = Eigen::Vector3d(0.1, 0.01, 0);
+  healthy.v_b = {1.05, 0, 0};
+  healthy.last_keyframe_at = t_b - kSec / 2;
+  EXPECT_EQ(disagreementWithImu(healthy, a, b, c), "");
+  VisualIncrement stalled = healthy;  // white walls: no keyframe for 3 s while the robot drives on
+  stalled.last_keyframe_at = t_b - 3 * kSec;
+  EXPECT_NE(disagreementWithImu(stalled, a, b, c).find("no keyframe for 3.0 s"), std::string::npos);
+  imu::NavState a_still = a, b_still = b;  // standing still, no keyframe is due
+  a_still.v_world.setZero();
+  b_still.v_world.setZero();
+  b_still.T_world_imu = T_a;
+  VisualIncrement still = stalled;
+  still.T_a_b.translation().setZero();
+  still.v_b.setZero();
+  EXPECT_EQ(disagreementWithImu(still, a_still, b_still, c), "");
+  VisualIncrement jumped = healthy;  // the catch-up: 3 m in a few frames
   jumped.T_a_b.translation() = Eigen::Vector3d(0.9, 0, 0);
   EXPECT_NE(disagreementWithImu(jumped, a, b, c).find("motion"), std::string::npos);
+  VisualIncrement fast = healthy;
+  fast.v_b = {2.5, 0, 0};
+  EXPECT_NE(disagreementWithImu(fast, a, b, c).find("velocity"), std::string::npos);
 }
 
 }  // namespace drover::pipeline

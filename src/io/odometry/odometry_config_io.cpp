@@ -118,6 +118,8 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bind("full_features", c.full_features)
       .bindSeconds("warmup", c.warmup, atLeast(0, "s"))
       .bindSeconds("max_age", c.max_age, atLeast(0, "s"))
+      .bindSeconds("max_keyframe_gap", c.max_keyframe_gap, atLeast(0, "s"))
+      .bind("standing_speed", c.standing_speed)
       .bind("max_velocity_difference", c.max_velocity_difference)
       .bind("max_position_difference", c.max_position_difference);
 }
