@@ -199,11 +199,11 @@ TEST(VisualMotion, AStalledOrJumpingVisIsRefusedAHealthyOrStandingOneIsKept) {
   const Time t_b = 10 * kSec;
   const imu::NavState a{t_b - kSec / 10, T_a, T_a.linear() * Eigen::Vector3d(1, 0, 0)};
   const imu::NavState b{t_b, T_b, a.v_world};
-  const VisualMotionConfig c;  // keyframe gap 2 s, standing 0.2 m/s, 1 m/s, 0.5 m
+  const VisualMotionConfig c;  // keyframe gap 0.5 s, standing 0.2 m/s, 1 m/s, 0.5 m
   VisualIncrement healthy;
   healthy.T_a_b.translation() = Eigen::Vector3d(0.1, 0.01, 0);
   healthy.v_b = {1.05, 0, 0};
-  healthy.last_keyframe_at = t_b - kSec / 2;
+  healthy.last_keyframe_at = t_b - kSec / 5;
   EXPECT_EQ(disagreementWithImu(healthy, a, b, c), "");
   VisualIncrement stalled = healthy;  // white walls: no keyframe for 3 s while the robot drives on
   stalled.last_keyframe_at = t_b - 3 * kSec;
