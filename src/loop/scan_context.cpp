@@ -170,22 +170,35 @@ ShiftMatch fullShiftSearch(const ScanContext& a, const ScanContext& b) {
   return searchShifts(a, b, 0, static_cast<int>(a.image.cols()));
 }
 
-ShiftMatch narrowedShiftSearch(const ScanContext& a, const ScanContext& b, std::optional<double> yaw_prior,
+ShiftMatch narrowedShiftSearch(const ScanContext& a, const ScanContext& b, std::optional<YawPrior> prior,
                                const ScanContextConfig& config) {
   requireSameShape(a, b);
   const int sectors = static_cast<int>(a.image.cols());
-  if (yaw_prior && std::isfinite(*yaw_prior) && 2 * config.search_radius + 1 < sectors) {
-    const int center = shiftFromYaw(*yaw_prior, sectors);
-    ShiftMatch m = searchShifts(a, b, center - config.search_radius, 2 * config.search_radius + 1);
-    m.narrowed = true;
-    if (m.distance < config.threshold) return m;
-    const int evaluated = m.evaluated;
+  const int r = config.search_radius;
+  if (!prior || !std::isfinite(prior->yaw) || 2 * r + 1 >= sectors) return fullShiftSearch(a, b);
+  const int center = shiftFromYaw(prior->yaw, sectors);
+  ShiftMatch m = searchShifts(a, b, center - r, 2 * r + 1);
+  m.narrowed = true;
+  if (m.distance < config.threshold || prior->fallback_radius <= r) return m;
+  const int window_evaluated = m.evaluated;
+  if (2 * prior->fallback_radius + 1 >= sectors) {  // the paper's fall-back: the full search, window included
     m = fullShiftSearch(a, b);
-    m.fell_back = true;
-    m.evaluated += evaluated;
-    return m;
+    m.evaluated += window_evaluated;
+  } else {  // only the shifts beyond the window on either side (a tie keeps the window's best)
+    const int side = prior->fallback_radius - r;
+    for (const ShiftMatch& s : {searchShifts(a, b, center + r + 1, side),
+                                searchShifts(a, b, center - prior->fallback_radius, side)}) {
+      if (s.distance < m.distance) {
+        m.distance = s.distance;
+        m.shift = s.shift;
+        m.yaw = s.yaw;
+      }
+      m.evaluated += s.evaluated;
+    }
+    m.narrowed = false;
   }
-  return fullShiftSearch(a, b);
+  m.fell_back = true;
+  return m;
 }
 
 int sectorKeyShift(const ScanContext& a, const ScanContext& b) {
@@ -214,7 +227,7 @@ ShiftMatch sectorKeyShiftSearch(const ScanContext& a, const ScanContext& b, cons
 }
 
 AugmentedMatch augmentedShiftSearch(const ScanContext& a, const AugmentedScanContext& b,
-                                    std::optional<double> yaw_prior, const ScanContextConfig& config) {
+                                    std::optional<YawPrior> yaw_prior, const ScanContextConfig& config) {
   if (b.descriptors.empty() || b.descriptors.size() != b.offsets.size())
     throw std::invalid_argument("augmented scan context has no descriptors or mismatched offsets");
   AugmentedMatch best;

@@ -68,15 +68,29 @@ struct ShiftMatch {
   int shift = 0;          // [sectors], in [0, sectors)
   double yaw = 0.0;       // [rad] yawFromShift(shift)
   bool narrowed = false;  // found by the prior-narrowed search (false: full search, or fell back to it)
-  bool fell_back = false; // a prior was given but its window's best failed the threshold
+  bool fell_back = false; // a prior was given, its window's best failed the threshold and more shifts were searched
   int evaluated = 0;      // shifts whose distance was computed
+};
+
+// A yaw prior [rad] (as narrowedShiftSearch's) and how far its fall-back may reach: when the best of the narrowed
+// window (+-config.search_radius sectors) fails the threshold, the search goes on over the shifts within
+// +-fallback_radius sectors of the prior's shift; every shift once that covers them all (the default: the paper's
+// fall-back to the full search), none when fallback_radius <= search_radius. A caller that knows how far the prior
+// can be off (the loop closure's rotation drift budget) so skips the shifts no acceptable loop could have.
+// Implicit from a yaw, so callers that only have a yaw keep the full fall-back.
+struct YawPrior {
+  static constexpr int kFullFallback = 1 << 20;  // [sectors] more than any descriptor has
+  YawPrior(double yaw_ = 0.0, int fallback_radius_ = kFullFallback) : yaw(yaw_), fallback_radius(fallback_radius_) {}
+  double yaw;           // [rad]
+  int fallback_radius;  // [sectors]
 };
 
 // Every shift.
 ShiftMatch fullShiftSearch(const ScanContext& a, const ScanContext& b);
-// Shifts within config.search_radius of the prior's shift (shiftFromYaw(*yaw_prior)); the full search when there is
-// no prior or the best found is not below config.threshold.
-ShiftMatch narrowedShiftSearch(const ScanContext& a, const ScanContext& b, std::optional<double> yaw_prior,
+// Shifts within config.search_radius of the prior's shift (shiftFromYaw(prior->yaw)); when there is no prior the
+// full search, and when the best found is not below config.threshold the fall-back of YawPrior (fell_back = true
+// when it searched any further shift; a partial fall-back does not evaluate the window's shifts again).
+ShiftMatch narrowedShiftSearch(const ScanContext& a, const ScanContext& b, std::optional<YawPrior> prior,
                                const ScanContextConfig& config);
 
 // The reference implementation's coarse alignment: argmin over shifts n of the L1 distance between A's sector key
@@ -102,7 +116,7 @@ struct AugmentedMatch {
 };
 // Full (no prior) or prior-narrowed search (narrowedShiftSearch) of descriptor A against every descriptor of B.
 AugmentedMatch augmentedShiftSearch(const ScanContext& a, const AugmentedScanContext& b,
-                                    std::optional<double> yaw_prior, const ScanContextConfig& config);
+                                    std::optional<YawPrior> yaw_prior, const ScanContextConfig& config);
 
 // The relative pose of the query (B) in the candidate's (A) lidar frame that a match implies: yaw about z from
 // the shift, applied to R_candidate_query_tilt's roll and pitch (e.g. the estimate's relative rotation; identity

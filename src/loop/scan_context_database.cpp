@@ -85,7 +85,7 @@ void ScanContextDatabase::add(int id, ScanContext descriptor) {
 }
 
 DatabaseQuery ScanContextDatabase::query(const AugmentedScanContext& q,
-                                         const std::function<std::optional<double>(int)>& yaw_prior) const {
+                                         const std::function<std::optional<YawPrior>(int)>& yaw_prior) const {
   DatabaseQuery out;
   const Impl& m = *impl_;
   out.searchable = static_cast<int>(m.indexed);
@@ -122,7 +122,7 @@ DatabaseQuery ScanContextDatabase::query(const AugmentedScanContext& q,
     LoopCandidate c;
     c.id = m.ids[entry];
     c.ring_key_distance = std::sqrt(static_cast<double>(r.d2));
-    const std::optional<double> prior = yaw_prior ? yaw_prior(c.id) : std::nullopt;
+    const std::optional<YawPrior> prior = yaw_prior ? yaw_prior(c.id) : std::nullopt;
     // The real position, and the virtual one that retrieved the entry when that is another; the better is kept.
     const auto offset = [&](std::size_t v) { return q.offsets.size() > v ? q.offsets[v] : Eigen::Vector2f::Zero(); };
     const ScanContext& entry_descriptor = m.descriptors[entry];

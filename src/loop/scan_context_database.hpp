@@ -55,9 +55,10 @@ class ScanContextDatabase {
 
   // Candidates for the query (descriptors[0] = the real sensor position). yaw_prior(id), when given and returning a
   // value, is the expected yaw [rad] of the query relative to entry `id` (p_entry = Rz(yaw) p_query), e.g. from the
-  // current trajectory estimate: it narrows that candidate's shift search to +-search_radius sectors.
+  // current trajectory estimate: it narrows that candidate's shift search to +-search_radius sectors, with the
+  // fall-back the YawPrior allows (a plain yaw: the full search).
   DatabaseQuery query(const AugmentedScanContext& query,
-                      const std::function<std::optional<double>(int id)>& yaw_prior = {}) const;
+                      const std::function<std::optional<YawPrior>(int id)>& yaw_prior = {}) const;
 
   // Drops entry `id` for good (its keyframe's clouds were retired, a newer keyframe stands for the place): it is
   // never a candidate again and its descriptor is freed. Removing twice is harmless; an unknown id throws

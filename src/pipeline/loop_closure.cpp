@@ -28,38 +28,6 @@ struct Candidate {
 
 }  // namespace
 
-const char* toString(LoopSource source) {
-  switch (source) {
-    case LoopSource::kRadius:
-      return "radius";
-    case LoopSource::kBoth:
-      return "both";
-    case LoopSource::kScanContext:
-      break;
-  }
-  return "scancontext";
-}
-
-std::string LoopClosureConfig::validate() const {
-  if (std::string e = database.validate(); !e.empty()) return "database: " + e;
-  if (std::string e = verifier.validate(); !e.empty()) return "verifier: " + e;
-  if (std::string e = graph.validate(); !e.empty()) return "graph: " + e;
-  const double positive[] = {radius, odometry_sigma_position, odometry_sigma_rotation, degenerate_sigma,
-                             max_drift_floor, max_rotation_drift_floor};
-  for (double v : positive)
-    if (!std::isfinite(v) || v <= 0)
-      return "radius, odometry_sigma_*, degenerate_sigma, max_drift_floor and max_rotation_drift_floor must be finite "
-             "and > 0";
-  for (double v : {max_drift_ratio, degenerate_drift, max_rotation_drift_ratio, degenerate_rotation_drift})
-    if (!std::isfinite(v) || v < 0)
-      return "max_drift_ratio, degenerate_drift, max_rotation_drift_ratio and degenerate_rotation_drift must be "
-             "finite and >= 0";
-  if (!std::isfinite(min_age) || min_age < 0) return "min_age must be finite and >= 0 s";
-  if (submap_keyframes < 0 || max_verifications < 1 || skip_after_loop < 0)
-    return "submap_keyframes and skip_after_loop must be >= 0, max_verifications >= 1";
-  return {};
-}
-
 struct LoopClosure::Impl {
   LoopClosureConfig config;
   loop::ScanContextDatabase database;
@@ -69,6 +37,7 @@ struct LoopClosure::Impl {
   std::vector<bool> searched;             // by keyframe
   std::vector<double> degenerate_before;  // by keyframe: degenerate directions reported up to it (cumulative)
   std::vector<double> degenerate_rotation_before;  // the same, their rotational share only (|phi|^2 of each)
+  std::vector<double> path_before;  // [m] by keyframe: the odometry's path length up to it, as it was added
   std::vector<LoopEvent> events;
   LoopStats stats;
   VisualYawPrior visual_prior;
@@ -136,6 +105,7 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   Impl& m = *impl_;
   if (index != m.times.size())
     throw std::invalid_argument(fmt::format("loop closure: keyframe {} given, {} expected", index, m.times.size()));
+  const Clock::time_point t_call = Clock::now();
   const lidar::Keyframe& kf = map.keyframe(index);
   m.times.push_back(kf.t);
   m.searched.push_back(false);
@@ -145,9 +115,16 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
   m.degenerate_rotation_before.push_back(
       (m.degenerate_rotation_before.empty() ? 0.0 : m.degenerate_rotation_before.back()) +
       degenerate_cov.bottomRightCorner<3, 3>().trace());
+  m.path_before.push_back(index == 0 ? 0.0
+                                      : m.path_before.back() + (kf.T_world_lidar.translation() -
+                                                                map.keyframe(index - 1).T_world_lidar.translation())
+                                                                   .norm());
   m.graph.addNode(static_cast<int>(index), kf.T_world_lidar);
   if (index > 0) m.addOdometryEdge(map, index, degenerate_cov);
-  if (!m.config.enabled) return false;
+  if (!m.config.enabled) {
+    m.stats.total_ms += msSince(t_call);
+    return false;
+  }
 
   auto t0 = Clock::now();
   const loop::AugmentedScanContext query =
@@ -170,6 +147,7 @@ bool LoopClosure::addKeyframe(const lidar::LocalMap& map, std::size_t index, con
     }
   }
   m.database.add(static_cast<int>(index), query.descriptors[0]);
+  m.stats.total_ms += msSince(t_call);
   return closed;
 }
 
@@ -182,7 +160,7 @@ std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map,
   const Eigen::Isometry3d& T_world_query = map.keyframe(index).T_world_lidar;
   if (config.source != LoopSource::kRadius) {
     auto t0 = Clock::now();
-    auto prior = [&](int id) -> std::optional<double> {
+    auto prior = [&](int id) -> std::optional<loop::YawPrior> {
       if (visual_prior) {
         if (std::optional<double> v = visual_prior(times[static_cast<std::size_t>(id)], times[index])) {
           ++stats.visual_priors;
@@ -190,11 +168,15 @@ std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map,
         }
       }
       if (!config.yaw_prior) return std::nullopt;
-      return geometry::yawOf(map.keyframe(static_cast<std::size_t>(id)).T_world_lidar.linear().transpose() *
-                   T_world_query.linear());
+      const std::size_t candidate = static_cast<std::size_t>(id);
+      return loop::YawPrior(
+          geometry::yawOf(map.keyframe(candidate).T_world_lidar.linear().transpose() * T_world_query.linear()),
+          shiftFallbackRadius(config, path_before[index] - path_before[candidate],
+                              degenerate_rotation_before[index] - degenerate_rotation_before[candidate]));
     };
     const loop::DatabaseQuery q = database.query(query, prior);
     stats.query_ms += msSince(t0);
+    stats.shifts_evaluated += static_cast<std::size_t>(q.shifts_evaluated);
     for (const loop::LoopCandidate& lc : q.candidates) {
       if (lc.match.match.narrowed) ++stats.narrowed_searches;
       if (lc.match.match.fell_back) ++stats.fallbacks;

@@ -28,12 +28,26 @@ namespace drover::pipeline {
 enum class LoopSource { kScanContext, kRadius, kBoth };
 const char* toString(LoopSource source);  // "scancontext", "radius", "both"
 
+// What a candidate's prior-narrowed shift search does when its window's best fails the threshold (see
+// LoopClosureConfig::shift_fallback).
+enum class ShiftFallback { kAlways, kBudget, kNever };
+const char* toString(ShiftFallback fallback);  // "always", "budget", "never"
+
 struct LoopClosureConfig {
   bool enabled = true;
   LoopSource source = LoopSource::kScanContext;
   loop::ScanContextDatabaseConfig database;  // descriptor (rings, sectors, radius, sensor height, threshold, dh)
   loop::LoopVerifierConfig verifier;
   bool yaw_prior = true;                  // narrow the shift search around the estimate's relative yaw (Eqs. 2-4)
+  // The narrowed search's fall-back when the window's best fails the threshold. kAlways: the full search (the
+  // paper's; every candidate that is another place then pays for both, 7 + 60 shifts per descriptor). kBudget: only
+  // the shifts the rotation drift budget since the candidate allows (below, charged along the keyframe chain, so
+  // never less than the acceptance check's), plus one sector for the descriptor's quantisation: a loop further off
+  // the estimate's yaw would be refused by that budget anyway. With the defaults that is +-4 sectors after 19 m of
+  // path, +-8 after 1 km, all 60 where the odometry was degenerate in rotation. A VisualYawPrior keeps the full
+  // fall-back: the budget bounds the estimate's drift, not the VIS's. kNever: the window only (a true revisit whose
+  // estimate drifted more than the window misses). Sectors: 2 pi / database.descriptor.sectors each.
+  ShiftFallback shift_fallback = ShiftFallback::kBudget;
   double min_age = 30.0;                  // [s] candidates at least this much older than the query (LIO-SAM 30 s)
   int submap_keyframes = 10;              // [keyframes] on each side of the candidate in its verification submap
   int max_verifications = 2;              // [-] candidates verified per keyframe at most (best Scan Context first)
@@ -92,6 +106,12 @@ struct LoopClosureConfig {
   std::string validate() const;  // empty when valid
 };
 
+// [sectors] How far the fall-back of a candidate's estimate-narrowed shift search reaches (loop::YawPrior) under
+// config.shift_fallback: kAlways every shift (YawPrior::kFullFallback), kNever 0, kBudget the rotation drift budget
+// over `path` [m] of odometry with `degenerate_rotation` degenerate rotational directions on the way, in sectors
+// rounded up, plus one.
+int shiftFallbackRadius(const LoopClosureConfig& config, double path, double degenerate_rotation);
+
 // One verified candidate, accepted or not.
 struct LoopEvent {
   std::size_t query = 0, candidate = 0;  // keyframe indices
@@ -121,7 +141,9 @@ struct LoopStats {
   std::size_t merged = 0;                            // of them, graph nodes merged into a newer keyframe's
   std::size_t unmerged = 0;                          // of them, kept as nodes: no accepted loop linked the places
   std::size_t degenerate_places = 0;                 // queries not searched and candidates dropped: degenerate there
+  std::size_t shifts_evaluated = 0;                  // column-distance evaluations of the shift searches
   double descriptor_ms = 0, query_ms = 0, verify_ms = 0, graph_ms = 0;  // totals [ms]
+  double total_ms = 0;  // [ms] every addKeyframe call, whole: the loop stage's own time (graph upkeep included)
 };
 
 // A yaw prior from another subsystem (the VIS's relative rotation between two keyframes' times, when it tracked

@@ -80,6 +80,15 @@ TEST(LoopConfigReader, TheLoopGraphIsFourDofOnlyWhenAskedAndTheImuIsFused) {
                    .graph.yaw_only_rotation);
 }
 
+TEST(LoopConfigReader, TheShiftFallBackIsTheBudgetsByDefaultAndTheOldFullSearchOnRequest) {
+  test::TempDir dir;
+  EXPECT_EQ(load(dir, "loop:\n  enabled: true\n").loop.shift_fallback, pipeline::ShiftFallback::kBudget);
+  EXPECT_EQ(load(dir, "loop:\n  shift_fallback: always\n").loop.shift_fallback, pipeline::ShiftFallback::kAlways);
+  EXPECT_EQ(load(dir, "loop:\n  shift_fallback: never\n").loop.shift_fallback, pipeline::ShiftFallback::kNever);
+  const std::string e = errorOf(dir, "loop:\n  shift_fallback: full\n");
+  EXPECT_TRUE(has(e, "line 2") && has(e, "loop.shift_fallback") && has(e, "budget")) << e;
+}
+
 TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {
   test::TempDir dir;
   std::string e = errorOf(dir, "loop:\n  scan_context:\n    rings: 20\n    ring: 20\n");

@@ -87,6 +87,41 @@ TEST(ScanContext, NarrowedSearchFallsBackToTheFullSearchWhenThePriorIsWrong) {
   EXPECT_EQ(none.shift, 7);
 }
 
+TEST(ScanContext, ABoundedFallBackSearchesOnlyTheShiftsBeyondTheWindowWithinItsReach) {
+  const ScanContextConfig cfg;
+  const double psi = 7 * 2 * kPi / 60;
+  const ScanContext a = makeScanContext(scene(), cfg), b = makeScanContext(turned(scene(), psi), cfg);
+  // The prior is 6 sectors off (shift 13): the window 10..16 misses shift 7.
+  const double prior = 13 * 2 * kPi / 60;
+  // Reach 8: 5..9 and 17..21 besides the window, 7 + 10 shifts; shift 7 is among them.
+  const ShiftMatch reached = narrowedShiftSearch(a, b, YawPrior(prior, 8), cfg);
+  EXPECT_TRUE(reached.fell_back);
+  EXPECT_FALSE(reached.narrowed);
+  EXPECT_EQ(reached.shift, 7);
+  EXPECT_EQ(reached.evaluated, 7 + 10);
+  // Reach 5: 8..9 and 17..18 only; shift 7 is not among them, the nearest one, 8, is the best reached.
+  const ShiftMatch short_reach = narrowedShiftSearch(a, b, YawPrior(prior, 5), cfg);
+  EXPECT_TRUE(short_reach.fell_back);
+  EXPECT_EQ(short_reach.evaluated, 7 + 4);
+  EXPECT_EQ(short_reach.shift, 8);
+  EXPECT_GT(short_reach.distance, reached.distance);
+}
+
+TEST(ScanContext, NoFallBackReachKeepsTheWindowsBestEvenAboveTheThreshold) {
+  const ScanContextConfig cfg;
+  const double psi = 7 * 2 * kPi / 60;
+  const ScanContext a = makeScanContext(scene(), cfg), b = makeScanContext(turned(scene(), psi), cfg);
+  const ShiftMatch m = narrowedShiftSearch(a, b, YawPrior(psi + kPi / 2, cfg.search_radius), cfg);
+  EXPECT_TRUE(m.narrowed);
+  EXPECT_FALSE(m.fell_back);
+  EXPECT_EQ(m.evaluated, 7);
+  EXPECT_GE(m.distance, cfg.threshold);
+  // A correct prior with no reach finds the place as before.
+  const ShiftMatch good = narrowedShiftSearch(a, b, YawPrior(psi, 0), cfg);
+  EXPECT_EQ(good.shift, 7);
+  EXPECT_LT(good.distance, cfg.threshold);
+}
+
 TEST(ScanContext, EmptyCloudGivesAnEmptyDescriptorAtDistanceOne) {
   const ScanContextConfig cfg;
   const ScanContext e = makeScanContext({}, cfg), a = makeScanContext(scene(), cfg);

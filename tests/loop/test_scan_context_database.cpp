@@ -93,6 +93,22 @@ TEST(ScanContextDatabase, AYawPriorNarrowsEachCandidatesSearchToSevenShifts) {
     EXPECT_TRUE(narrowed.candidates[i].match.match.fell_back);
 }
 
+TEST(ScanContextDatabase, APriorWithoutFallBackReachScoresOtherPlacesByTheirWindowOnly) {
+  ScanContextDatabase db(config(0));
+  for (int id = 0; id < 20; ++id) db.add(id, makeScanContext(place(id), db.config().descriptor));
+  const double psi = 9 * kSector;
+  const AugmentedScanContext q = makeAugmentedScanContext(turned(place(4), psi), db.config().descriptor);
+  const DatabaseQuery r = db.query(q, [&](int) { return std::optional<YawPrior>(YawPrior(psi + 0.5 * kSector, 3)); });
+  ASSERT_EQ(r.candidates.size(), 10u);
+  EXPECT_EQ(r.candidates[0].id, 4);  // the revisit is still found, in its window
+  EXPECT_EQ(r.candidates[0].match.match.shift, 9);
+  EXPECT_EQ(r.shifts_evaluated, 10 * 7);  // no candidate paid for a fall-back
+  for (std::size_t i = 1; i < r.candidates.size(); ++i) {
+    EXPECT_FALSE(r.candidates[i].match.match.fell_back);
+    EXPECT_GE(r.candidates[i].match.match.distance, db.config().descriptor.threshold);
+  }
+}
+
 // Removal (a retired keyframe): an entry removed after it became searchable, and one removed while still among the
 // newest, are never returned again; their descriptors are freed; the place a removed entry stood for is found in
 // the entry that replaced it.

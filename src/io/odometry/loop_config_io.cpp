@@ -10,6 +10,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
   s.bind("enabled", c.enabled)
       .bindChoice("source", e.source, {"scancontext", "radius", "both"})
       .bind("yaw_prior", c.yaw_prior)
+      .bindChoice("shift_fallback", e.shift_fallback, {"always", "budget", "never"})
       .bindSeconds("min_age", c.min_age, atLeast(0, "s"))
       .bind("submap_keyframes", c.submap_keyframes)
       .bind("max_verifications", c.max_verifications)
@@ -65,6 +66,9 @@ void applyLoopEnums(const LoopEnumStrings& e, pipeline::LoopClosureConfig& c) {
              : e.source == "both" ? pipeline::LoopSource::kBoth
                                   : pipeline::LoopSource::kScanContext;
   c.graph.loop_loss = backend::parseRobustLoss(e.loop_loss);
+  c.shift_fallback = e.shift_fallback == "always"  ? pipeline::ShiftFallback::kAlways
+                     : e.shift_fallback == "never" ? pipeline::ShiftFallback::kNever
+                                                   : pipeline::ShiftFallback::kBudget;
 }
 
 }  // namespace drover::io

@@ -1,7 +1,8 @@
 #pragma once
 // The `loop:` section of a platform config -> pipeline::LoopClosureConfig (read by loadOdometryConfig). Keys, all
 // optional (left out = the defaults in pipeline/loop_closure.hpp and loop/*.hpp, which give the units):
-//   loop: enabled, source (scancontext | radius | both), yaw_prior, min_age [s], submap_keyframes,
+//   loop: enabled, source (scancontext | radius | both), yaw_prior, shift_fallback (always | budget | never),
+//         min_age [s], submap_keyframes,
 //         max_verifications, skip_after_loop, radius [m], odometry_sigma_position [m], odometry_sigma_rotation [rad],
 //         degenerate_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m],
 //         max_rotation_drift_floor [rad], max_rotation_drift_ratio [rad/m], degenerate_rotation_drift [rad]
@@ -20,7 +21,7 @@ namespace drover::io {
 
 // Enumerations travel as strings and are applied by applyLoopEnums after YamlSection::apply.
 struct LoopEnumStrings {
-  std::string source = "scancontext", loop_loss = "huber";
+  std::string source = "scancontext", loop_loss = "huber", shift_fallback = "budget";
 };
 
 void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStrings& e);
