@@ -36,10 +36,15 @@ std::optional<VisualState> VisualStateStream::onFrame(const vio::FrameResult& r)
   if (r.just_initialized) {
     ++init_count_;
     init_time_ = keyframe_time_ = r.t;
+    keyframe_interval_ = 0;
   }
   if (!r.initialized) return std::nullopt;
-  if (r.keyframe) keyframe_time_ = r.t;
-  return VisualState{r.t, r.T_world_imu, r.v_world, r.bias, r.features, init_count_, init_time_, keyframe_time_};
+  if (r.keyframe) {
+    keyframe_interval_ = r.t - keyframe_time_;
+    keyframe_time_ = r.t;
+  }
+  return VisualState{r.t,         r.T_world_imu, r.v_world,      r.bias,           r.features,
+                     init_count_, init_time_,    keyframe_time_, keyframe_interval_};
 }
 
 VisualMotion::VisualMotion(const VisualMotionConfig& config, const imu::PreintegrationConfig& imu)
@@ -110,6 +115,7 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   inc.T_a_b = xa->T_world_imu.inverse() * xb->T_world_imu;
   inc.v_b = xb->T_world_imu.linear().transpose() * xb->v_world;
   inc.last_keyframe_at = sb->last_keyframe_at;
+  inc.keyframe_interval = sb->keyframe_interval;
   // Fewer features than a full frame: the sigmas grow as 1/sqrt(n), as a mean over n independent features would.
   const int n = std::min(sa->features, sb->features);
   const double scale = std::sqrt(static_cast<double>(config_.full_features) / std::min(n, config_.full_features));
@@ -129,7 +135,7 @@ namespace drover::pipeline {
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
                                 const VisualMotionConfig& config) {
   const Eigen::Vector3d v_b_imu = b.T_world_imu.linear().transpose() * b.v_world;
-  const double gap = toSeconds(b.t - inc.last_keyframe_at);
+  const double gap = std::max(toSeconds(b.t - inc.last_keyframe_at), toSeconds(inc.keyframe_interval));
   if (gap > config.max_keyframe_gap && v_b_imu.norm() > config.standing_speed)
     return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s", gap, v_b_imu.norm());
   const double dv = (inc.v_b - v_b_imu).norm();

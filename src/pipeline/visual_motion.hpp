@@ -37,7 +37,8 @@ struct VisualMotionConfig {
   // A VIS that lost its features can stall: on the farm's white walls it made no keyframe for 35 s (its window
   // kept the old ones), held still for 3 s while the robot drove 2.7 m on, then jumped 3 m back to the truth.
   // While the LIS's IMU prediction says the robot moves faster than `standing_speed`, a VIS whose last keyframe is
-  // older than `max_keyframe_gap` is not used (standing still, no keyframe is due). Gating on the LIS's own
+  // older than `max_keyframe_gap`, or came more than that after the one before, is not used (standing still, no
+  // keyframe is due): a lone keyframe in a stall re-enabled it for 0.5 s, which took the LIS from 0.88 to 0.42 m/s. Gating on the LIS's own
   // velocity instead caught the stall only after it had dragged that velocity down, then locked the recovered VIS
   // out. Gross disagreement with the IMU prediction of the sweep interval (the catch-up jump) is refused too.
   double max_keyframe_gap = 0.5;          // [s] (a moving VIS makes 7-10 keyframes a second)
@@ -59,6 +60,7 @@ struct VisualState {
   std::uint32_t reset_id = 0; // the VIS's (re)initialisation count: states of different IDs are not related
   Time initialized_at = 0;    // [ns] when the VIS last (re)initialised
   Time last_keyframe_at = 0;  // [ns] the VIS's newest keyframe (its initialisation when none since)
+  Time keyframe_interval = 0; // [ns] from the keyframe before it (0 when none)
 };
 
 // The VIS's per-frame results as VisualStates, its (re)initialisations numbered (LVI-SAM's reset ID). Shared by
@@ -70,7 +72,7 @@ class VisualStateStream {
 
  private:
   std::uint32_t init_count_ = 0;
-  Time init_time_ = 0, keyframe_time_ = 0;
+  Time init_time_ = 0, keyframe_time_ = 0, keyframe_interval_ = 0;
 };
 
 // The VIS's motion T_a_b = T_world_imu(a)^-1 T_world_imu(b) with the square-root information of its error
@@ -80,6 +82,7 @@ struct VisualIncrement {
   Eigen::Matrix<double, 6, 6> sqrt_information = Eigen::Matrix<double, 6, 6>::Identity();
   Eigen::Vector3d v_b = Eigen::Vector3d::Zero();  // [m/s] the VIS's velocity at b in the IMU frame at b
   Time last_keyframe_at = 0;                      // [ns] of the VIS state used at b
+  Time keyframe_interval = 0;                     // [ns] of the VIS state used at b
 };
 
 // Empty when the increment agrees with the IMU's prediction of the same interval (states at a and b, world frame

@@ -165,6 +165,7 @@ TEST(VisualMotion, TheStateStreamNumbersTheVisInitialisationsAndSkipsFramesWitho
   EXPECT_EQ(stream.onFrame(r)->reset_id, 1u);
   r.t = 35, r.keyframe = false;
   EXPECT_EQ(stream.onFrame(r)->last_keyframe_at, 30);
+  EXPECT_EQ(stream.onFrame(r)->keyframe_interval, 10);
   r.t = 40, r.initialized = false, r.reset = true;  // a failure cleared the window
   EXPECT_FALSE(stream.onFrame(r));
   r.t = 50, r.initialized = r.just_initialized = true, r.reset = false;
@@ -208,6 +209,11 @@ TEST(VisualMotion, AStalledOrJumpingVisIsRefusedAHealthyOrStandingOneIsKept) {
   VisualIncrement stalled = healthy;  // white walls: no keyframe for 3 s while the robot drives on
   stalled.last_keyframe_at = t_b - 3 * kSec;
   EXPECT_NE(disagreementWithImu(stalled, a, b, c).find("no keyframe for 3.0 s"), std::string::npos);
+  VisualIncrement lone = healthy;  // one keyframe 0.2 s ago, after a 4.5 s stall: not yet healthy again
+  lone.keyframe_interval = 4'500'000'000;
+  EXPECT_NE(disagreementWithImu(lone, a, b, c).find("no keyframe for 4.5 s"), std::string::npos);
+  lone.keyframe_interval = kSec / 8;  // a moving VIS: 7-10 keyframes a second
+  EXPECT_EQ(disagreementWithImu(lone, a, b, c), "");
   imu::NavState a_still = a, b_still = b;  // standing still, no keyframe is due
   a_still.v_world.setZero();
   b_still.v_world.setZero();
