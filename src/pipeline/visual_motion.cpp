@@ -13,20 +13,16 @@ namespace drover::pipeline {
 std::string VisualMotionConfig::validate() const {
   for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position", sigma_position},
                                 {"sigma_rotation", sigma_rotation},
-                                {"max_age", max_age}})
+                                {"max_age", max_age},
+                                {"max_keyframe_gap", max_keyframe_gap},
+                                {"max_velocity_difference", max_velocity_difference},
+                                {"max_position_difference", max_position_difference}})
     if (!std::isfinite(v) || v <= 0) return fmt::format("{} must be finite and > 0, got {}", name, v);
   for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position_ratio", sigma_position_ratio},
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
-                                {"warmup", warmup}})
+                                {"warmup", warmup},
+                                {"standing_speed", standing_speed}})
     if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
-  if (!(max_keyframe_gap > 0) || !std::isfinite(max_keyframe_gap) || !(standing_speed >= 0) ||
-      !std::isfinite(standing_speed))
-    return fmt::format("max_keyframe_gap must be finite and > 0 and standing_speed >= 0, got {} and {}",
-                       max_keyframe_gap, standing_speed);
-  if (!(max_velocity_difference > 0) || !(max_position_difference > 0) || !std::isfinite(max_velocity_difference) ||
-      !std::isfinite(max_position_difference))
-    return fmt::format("max_velocity_difference and max_position_difference must be finite and > 0, got {} and {}",
-                       max_velocity_difference, max_position_difference);
   if (min_features < 1 || full_features < min_features)
     return fmt::format("need 0 < min_features <= full_features, got {} and {}", min_features, full_features);
   return {};

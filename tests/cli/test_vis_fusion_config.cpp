@@ -1,0 +1,58 @@
+// The `odometry.vis_fusion` section (how the VIS's motion enters the LIS): every key reaches its own field, and a
+// bad value or an unknown key is an IoError naming the file, the line or section and the key.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "io/odometry/odometry_config_io.hpp"
+#include "odometry_config_test_util.hpp"
+#include "support/temp_dir.hpp"
+
+namespace drover::io {
+namespace {
+
+using test_config::errorOf;
+using test_config::has;
+using test_config::load;
+
+TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
+  test::TempDir dir;
+  const pipeline::VisualMotionConfig c =
+      load(dir,
+           "odometry:\n  vis_fusion:\n    factor: false\n    initial_guess: false\n    sigma_position: 0.03\n"
+           "    sigma_position_ratio: 0.06\n    sigma_rotation: 0.02\n    sigma_rotation_ratio: 0.07\n"
+           "    min_features: 25\n    full_features: 90\n    warmup: 1.5\n    max_age: 0.25\n"
+           "    max_keyframe_gap: 0.6\n    standing_speed: 0.3\n    max_velocity_difference: 1.1\n"
+           "    max_position_difference: 0.45\n")
+          .vis_fusion;
+  EXPECT_FALSE(c.factor);
+  EXPECT_FALSE(c.initial_guess);
+  EXPECT_DOUBLE_EQ(c.sigma_position, 0.03);
+  EXPECT_DOUBLE_EQ(c.sigma_position_ratio, 0.06);
+  EXPECT_DOUBLE_EQ(c.sigma_rotation, 0.02);
+  EXPECT_DOUBLE_EQ(c.sigma_rotation_ratio, 0.07);
+  EXPECT_EQ(c.min_features, 25);
+  EXPECT_EQ(c.full_features, 90);
+  EXPECT_DOUBLE_EQ(c.warmup, 1.5);
+  EXPECT_DOUBLE_EQ(c.max_age, 0.25);
+  EXPECT_DOUBLE_EQ(c.max_keyframe_gap, 0.6);
+  EXPECT_DOUBLE_EQ(c.standing_speed, 0.3);
+  EXPECT_DOUBLE_EQ(c.max_velocity_difference, 1.1);
+  EXPECT_DOUBLE_EQ(c.max_position_difference, 0.45);
+}
+
+TEST(VisFusionConfigReader, BadValuesAndUnknownKeysAreErrorsNamingFileAndKey) {
+  test::TempDir dir;
+  const std::string file = (dir / "odometry.yaml").string();
+  const std::string negative = errorOf(dir, "odometry:\n  vis_fusion:\n    max_age: -1\n");
+  EXPECT_TRUE(has(negative, file) && has(negative, "max_age")) << negative;
+  const std::string order = errorOf(dir, "odometry:\n  vis_fusion:\n    min_features: 100\n");
+  EXPECT_TRUE(has(order, file) && has(order, "section 'odometry'") && has(order, "min_features")) << order;
+  const std::string zero = errorOf(dir, "odometry:\n  vis_fusion:\n    max_position_difference: 0\n");
+  EXPECT_TRUE(has(zero, file) && has(zero, "max_position_difference")) << zero;
+  const std::string unknown = errorOf(dir, "odometry:\n  vis_fusion:\n    facter: true\n");
+  EXPECT_TRUE(has(unknown, "line 3") && has(unknown, "'odometry.vis_fusion.facter'")) << unknown;
+}
+
+}  // namespace
+}  // namespace drover::io
