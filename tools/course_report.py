@@ -13,6 +13,8 @@ the nearer sample) when within one ground-truth step. Figures:
   start_end_m        |p_est(end) - p_est(start)| (closed courses end where they start)
   segments[]         per labelled segment: relative pose error between its first and last sweep,
                      translation as % of the segment's path length and rotation in degrees
+                     (injected faults, scenario.json "faults", as segments "fault:KIND" from the fault's start to
+                     10 s after its end: what the fault and the re-joining cost)
 Deliberately independent of Drover's C++ evaluator (numpy only), so the two can check each other.
 """
 import argparse
@@ -106,7 +108,12 @@ def main():
         "start_end_m": float(np.linalg.norm(est_a[-1][:3, 3] - est_a[0][:3, 3])),
         "segments": [],
     }
-    for seg in scenario.get("segments", []):
+    # Injected faults (drover sim --fault): the window and the 10 s after it, where the failing side re-joins.
+    windows = list(scenario.get("segments", []))
+    for f in scenario.get("faults", []):
+        windows.append({"condition": "fault:" + f["kind"], "start_ns": f["start_ns"],
+                        "end_ns": f["end_ns"] + 10_000_000_000})
+    for seg in windows:
         sel = np.nonzero((times >= seg["start_ns"]) & (times <= seg["end_ns"]))[0]
         if len(sel) < 2:
             continue
@@ -124,7 +131,7 @@ def main():
     print(f"{out['scenario']}: {out['sweeps']} sweeps, {length:.1f} m; end error {out['end_error_m']:.3f} m "
           f"({out['drift_percent']:.2f} %), max {out['max_error_m']:.3f} m, start-end {out['start_end_m']:.3f} m")
     for s in out["segments"]:
-        print(f"  {s['condition']:>13} {s['start_s']:7.1f}-{s['end_s']:7.1f} s {s['length_m']:7.1f} m: "
+        print(f"  {s['condition']:>21} {s['start_s']:7.1f}-{s['end_s']:7.1f} s {s['length_m']:7.1f} m: "
               f"{s['translation_error_m']:.3f} m ({s['translation_error_percent']:.2f} %), "
               f"{s['rotation_error_deg']:.2f} deg")
     if a.json:

@@ -10,11 +10,13 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
+#include "apps/drover/run_preset.hpp"
 #include "apps/drover/run_realtime.hpp"
 #include "apps/drover/run_vis.hpp"
 #include "io/config.hpp"
@@ -30,7 +32,9 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 struct RunOptions {
-  std::string dataset, format, config, out;
+  std::string dataset, format, config, out, preset;
+  std::vector<std::string> without;  // --without: parts taken out after the preset
+  MethodChoice method() const { return {presetFromName(preset), without}; }
   bool no_imu = false, no_camera = false, no_lidar = false, no_loop = false, quiet = false, realtime = false;
   double start = 0, duration = 0;  // [s] from the first measurement; duration 0 = to the end
   double rate = 1.0;               // [-] --realtime: sensor seconds per wall second
@@ -168,7 +172,7 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   std::unique_ptr<RunVis> vis;  // with images, an IMU and usable intrinsics: the VIS in its own thread
   const bool camera = visual::validateIntrinsics(reader.calibration().camera).empty();
   if (camera && !o.no_camera && !o.no_imu && o.format != "kitti") {
-    VisSetup setup = loadVisSetup(o.config);
+    VisSetup setup = loadVisSetup(o.config, o.method());
     system_config.vis = setup.config;
     options.detector = setup.detector;
     vis = std::make_unique<RunVis>(setup);
@@ -180,7 +184,8 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
   // nothing behind, as StagedFolder removes OUT.partial unless published).
   io::StagedFolder folder(o.out, runFolderRules());
   RunContext context{o.dataset, o.format, o.config, o.out, reader.calibration(), reader.groundTruth(),
-                     folder.dir().string()};
+                     folder.dir().string(),
+                     o.method().describe()};
   RealtimeRun run;
   streamRunFiles(context, run.record, config.use_imu);
   runRealtime(reader, system_config, options, stop, run);
@@ -205,6 +210,7 @@ void runOdometry(const RunOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
   checkOptions(o);
   pipeline::OdometryConfig config = o.config.empty() ? pipeline::OdometryConfig{} : io::loadOdometryConfig(o.config);
+  o.method().apply(config);
   if (o.no_imu) config.use_imu = false;
   if (o.no_loop) config.loop.enabled = false;
   const io::DatasetOptions dataset_options = datasetOptions(o);
@@ -222,7 +228,8 @@ void runOdometry(const RunOptions& o) {
   // renamed at the end: a run that fails on its data leaves no folder behind, one killed while writing leaves an
   // earlier run in OUT whole.
   io::StagedFolder folder(o.out, runFolderRules());
-  RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string()};
+  RunContext context{o.dataset, o.format, o.config, o.out, reader->calibration(), gt, folder.dir().string(),
+                     o.method().describe()};
 
   const double gt_span = gt.poses.size() > 1 ? toSeconds(gt.poses.back().t - gt.poses.front().t) : 0.0;
   const double total = o.duration > 0 ? (gt_span > 0 ? std::min(o.duration, gt_span - o.start) : o.duration)
@@ -248,7 +255,7 @@ void runOdometry(const RunOptions& o) {
   bool camera_warned = false;
   const auto visFor = [&]() -> RunVis& {
     if (!vis) {
-      vis = std::make_unique<RunVis>(o.config, reader->calibration(), config.preintegration);
+      vis = std::make_unique<RunVis>(o.config, reader->calibration(), config.preintegration, o.method());
       if (last_imu) vis->onImu(*last_imu);  // the first frame's interval starts at the sample before it
       if (!no_lidar)
         odometry.setSweepListener([&vis](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
@@ -321,6 +328,16 @@ void registerRun(CLI::App& app) {
   cmd->add_option("--config", o->config, "Platform config (config/kitti.yaml, farm_sim.yaml, ...)");
   cmd->add_option("--out", o->out, "Run folder (written as OUT.partial, renamed when complete; replaces only an "
                                   "earlier run folder)")->required();
+  cmd->add_option("--preset", o->preset,
+                  "Methods of the paper's comparison over the platform config (which still sets the sensors): "
+                  "drover (SuperPoint, lidar depth factors, the VIS's motion as a factor, Scan Context with the VIS's "
+                  "yaw) or lvi-sam (Shi-Tomasi, fixed lidar depth, the VIS's motion as the guess only, radius loops); "
+                  "default: the platform config's own choices")
+      ->check(CLI::IsMember(presetNames()));
+  cmd->add_option("--without", o->without,
+                  "Take a part out after the preset (repeatable; the ablation): vo-factor, vis-guess, vis-gates, "
+                  "visual-yaw-prior, scan-context, depth-factor, superpoint")
+      ->check(CLI::IsMember(partNames()));
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");
   cmd->add_flag("--no-camera", o->no_camera, "Ignore the camera: the LIS alone (no VIS)");

@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
@@ -29,13 +30,33 @@ namespace {
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
+std::string joined(const std::vector<std::string>& names);
+
 struct SimOptions {
   std::string scenario, out, format = "folder", config, lidar, kitti_poses, kitti_times;
   std::uint64_t seed = 1;
   double duration = 0;     // [s], 0 = the scenario's natural length
   std::optional<double> camera_rate;  // [Hz]; unset: the config's, else 15
   bool no_camera = false, force = false, quiet = false;
+  std::vector<sim::SensorFault> faults;  // --fault, windows relative to the trajectory's start
 };
+
+// --fault KIND@START+DURATION, seconds from the trajectory's start: "camera-blackout@60+10".
+sim::SensorFault parseFault(const std::string& text) {
+  const io::ValueSource source = io::ValueSource::option("--fault");
+  const std::size_t at = text.find('@'), plus = text.find('+', at == std::string::npos ? 0 : at);
+  if (at == std::string::npos || plus == std::string::npos)
+    io::failValue(source, "expected KIND@START+DURATION (seconds), e.g. camera-blackout@60+10, got " + io::echo(text));
+  const std::optional<sim::FaultKind> kind = sim::faultKind(text.substr(0, at));
+  if (!kind)
+    io::failValue(source, "unknown fault " + io::echo(text.substr(0, at)) + " (expected one of: " +
+                              joined(sim::faultNames()) + ")");
+  sim::SensorFault f;
+  f.kind = *kind;
+  f.start = io::parseSecondsValue(text.substr(at + 1, plus - at - 1), io::between(0, io::kMaxSimDurationS, "s"), source);
+  f.end = f.start + io::parseSecondsValue(text.substr(plus + 1), io::Range{0, 600, true, false, "s"}, source);
+  return f;
+}
 
 std::string joined(const std::vector<std::string>& names) {
   std::string s;
@@ -83,6 +104,7 @@ sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
   if (s.camera_time_offset_s) c.camera_time_offset = fromSeconds(*s.camera_time_offset_s);
   if (s.noise && !*s.noise) c.lidar.noise = c.camera.noise = c.imu.noise = false;
   c.enable_camera = !o.no_camera;
+  c.faults = o.faults;
   if (std::string e = c.validate(); !e.empty()) throw std::invalid_argument("simulator settings: " + e);
   return c;
 }
@@ -148,7 +170,16 @@ void runSim(const SimOptions& o) {
     so.kitti05_ground_truth = &kitti05;
   }
   const sim::Scenario scenario = sim::makeScenario(o.scenario, so);
-  const sim::Simulator simulator(scenario, config, o.seed);
+  sim::SimulatorConfig faulted = config;
+  for (sim::SensorFault& f : faulted.faults) {  // relative to the trajectory's start, which must contain it
+    const Time start = scenario.trajectory->startTime(), end = scenario.trajectory->endTime();
+    if (f.start >= end - start)
+      throw std::invalid_argument(fmt::format("--fault {} starts at {:.3f} s, after the scenario's end at {:.3f} s",
+                                              sim::faultName(f.kind), toSeconds(f.start), toSeconds(end - start)));
+    f.start += start;
+    f.end += start;
+  }
+  const sim::Simulator simulator(scenario, faulted, o.seed);
   const sim::Simulator::Counts expected = simulator.expectedCounts();
   spdlog::info("simulating '{}' (seed {}, {:.1f} s, {:.0f} m): {} IMU samples, {} {} sweeps, {} frames -> {}",
                o.scenario, o.seed, toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime()),
@@ -205,6 +236,15 @@ void registerSim(CLI::App& app) {
   cmd->add_option("--kitti-poses", o->kitti_poses, "kitti05-replay: KITTI poses file (default ../shared/data)");
   cmd->add_option("--kitti-times", o->kitti_times, "kitti05-replay: KITTI times.txt (default ../shared/data)");
   cmd->add_flag("--no-camera", o->no_camera, "Do not render camera images");
+  cmd->add_option_function<std::vector<std::string>>(
+         "--fault",
+         [o](const std::vector<std::string>& texts) {
+           for (const std::string& text : texts) o->faults.push_back(parseFault(text));
+         },
+         "Inject a sensor fault, KIND@START+DURATION in seconds from the start (repeatable): camera-blackout (lens "
+         "covered), lidar-dropout (no sweeps), imu-gap (no samples), textureless (surfaces without texture); "
+         "written into scenario.json")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   cmd->add_flag("--force", o->force,
                 "Replace an existing output folder that holds an earlier simulated dataset (with --format bag: an "
                 "existing ROS bag)");

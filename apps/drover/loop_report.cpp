@@ -116,6 +116,8 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
          {"accepted", s.accepted},
          {"over_drift_budget", s.over_drift_budget},
          {"shift_fallback", pipeline::toString(loops.config().shift_fallback)},
+         {"visual_yaw_prior", loops.config().visual_yaw_prior},
+         {"visual_priors", s.visual_priors},  // shift searches narrowed around the VIS's yaw (the rest: the estimate's)
          {"narrowed_searches", s.narrowed_searches},
          {"fallbacks", s.fallbacks},
          {"shifts_evaluated", s.shifts_evaluated},

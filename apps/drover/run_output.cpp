@@ -94,6 +94,7 @@ Json statsJson(const pipeline::OdometryStats& s, const RunRecord& r) {
   j["imu_scans"] = s.imu_scans;
   j["vis_guess_scans"] = s.vis_guess_scans;    // sweeps matched from the VIS's motion (LVI-SAM's initial guess)
   j["vis_factor_scans"] = s.vis_factor_scans;  // sweeps whose IMU smoother had the VIS's motion as a factor
+  j["vis_resets_requested"] = s.vis_resets_requested;  // times the LIS asked a VIS its gates kept refusing to reset
   j["imu_initialized"] = s.imu_initialized;
   j["imu_init"] = s.imu_init;
   j["imu"] = {{"accepted", s.imu.accepted},
@@ -202,6 +203,7 @@ void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& 
   report["dataset"] = c.dataset;
   report["format"] = c.format;
   report["config"] = c.config;
+  report["preset"] = c.preset;
   report["mode"] = "camera+imu";
   report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};
   report["body_frame"] = c.ground_truth.body_frame.empty() ? "imu" : c.ground_truth.body_frame;
@@ -244,6 +246,7 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   report["dataset"] = c.dataset;
   report["format"] = c.format;
   report["config"] = c.config;
+  report["preset"] = c.preset;
   report["mode"] = s.imu_initialized ? "lidar+imu" : "lidar";  // what was fused (the IMU may have been given up)
   report["imu_requested"] = odometry.config().use_imu;
   report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};

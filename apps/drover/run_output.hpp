@@ -33,6 +33,7 @@ struct RunContext {
   const Calibration& calibration;
   const io::GroundTruth& ground_truth;
   std::string dir;  // where the files are written: OUT.partial, renamed to `out` when complete
+  std::string preset = "platform";  // drover run --preset (run_preset.hpp)
 };
 
 // A --realtime run (pipeline::System): its loop thread's loop closure and report.json's "realtime" section.

@@ -96,6 +96,7 @@ Json SweepLog::line(const pipeline::ScanOutcome& s) {
   if (s.vis_guess) j["vis_guess"] = true;
   if (s.vis_factor) j["vis_factor"] = true;
   if (!s.vis_unused.empty()) j["vis_unused"] = s.vis_unused;
+  if (!s.vis_reset.empty()) j["vis_reset"] = s.vis_reset;
   if (s.has_imu_state) {
     j["v_world"] = vectorJson(s.v_world);      // [m/s]
     j["gyro_bias"] = vectorJson(s.gyro_bias);  // [rad/s], IMU frame

@@ -19,10 +19,11 @@ constexpr std::size_t kShownResets = 20;  // reset warnings printed; the rest ar
 
 }  // namespace
 
-VisSetup loadVisSetup(const std::string& config_path) {
+VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method) {
   io::VisualConfig visual = config_path.empty() ? io::VisualConfig{} : io::loadVisualConfig(config_path);
   VisSetup setup;
   setup.config.vio = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
+  method.apply(visual, setup.config.vio);
   setup.config.tracker = visual.tracker;
   setup.config.depth = visual.depth;
   setup.detector_name = visual::detectorTypeName(visual.detector.type);
@@ -43,8 +44,9 @@ VisSetup loadVisSetup(const std::string& config_path) {
   return setup;
 }
 
-RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu) {
-  VisSetup setup = loadVisSetup(config_path);
+RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu,
+               const MethodChoice& method) {
+  VisSetup setup = loadVisSetup(config_path, method);
   detector_name_ = setup.detector_name;
   vio_config_ = setup.config.vio;
   own_ = std::make_unique<vio::VisualOdometry>(setup.config, calibration, imu, std::move(setup.detector));
@@ -70,6 +72,17 @@ void RunVis::onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::
 void RunVis::onLisState(const pipeline::ScanOutcome& outcome) {
   if (outcome.loop_closed) own_->onWorldCorrected(outcome.T_new_old);
   if (outcome.has_imu_state) lis_state_ = outcome;
+  if (!outcome.vis_reset.empty() && own_->estimator().initialized()) {
+    own_->reset();
+    noteReset(outcome.t, "reset by the LIS: " + outcome.vis_reset);
+  }
+}
+
+void RunVis::noteReset(Time t, const std::string& why) {
+  ++resets_;
+  if (resets_ <= kShownResets) spdlog::warn("VIS reset at {:.3f} s: {}", toSeconds(t), why);
+  if (resets_ == kShownResets) spdlog::warn("VIS: further resets are counted in report.json, not shown");
+  if (events_.size() < kMaxEvents) events_.push_back({t, "reset", why});
 }
 
 // The LIS's state at a camera stamp: the IMU-rate pose, a velocity from the poses 40 ms apart (first order; the
@@ -107,10 +120,7 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
 void RunVis::record(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
   if (r.reset) {
-    ++resets_;
-    if (resets_ <= kShownResets) spdlog::warn("VIS reset at {:.3f} s: {}", toSeconds(r.t), r.event);
-    if (resets_ == kShownResets) spdlog::warn("VIS: further resets are counted in report.json, not shown");
-    if (events_.size() < kMaxEvents) events_.push_back({r.t, "reset", r.event});
+    noteReset(r.t, r.event);
   } else if (r.just_initialized) {
     if (!first_init_) first_init_ = r.t;
     spdlog::info("VIS {} at {:.3f} s", r.event, toSeconds(r.t));

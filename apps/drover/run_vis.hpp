@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/drover/run_preset.hpp"
 #include "io/reader.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "types/trajectory.hpp"
@@ -32,12 +33,14 @@ struct VisSetup {
 };
 // Reads the `visual:` and `vio:` sections (defaults without a config). SuperPoint whose weights cannot be loaded
 // falls back to Shi-Tomasi with a warning.
-VisSetup loadVisSetup(const std::string& config_path);
+// A preset (run_preset.hpp) overrides the methods the config chose.
+VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method = {});
 
 class RunVis {
  public:
   // The replay: runs its own vio::VisualOdometry (onImu, onFrame, onSweep, onLisState).
-  RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu);
+  RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu,
+         const MethodChoice& method = {});
   // --realtime: the VisualOdometry runs in pipeline::System; record() each frame it took, and attach() it (after
   // the System's shutdown) for the report.
   explicit RunVis(const VisSetup& setup);
@@ -50,7 +53,8 @@ class RunVis {
   void onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis);
   // Every sweep the LIS processed (registered with LidarOdometry::setSweepListener).
   void onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points_lidar);
-  // The newest LIS sweep with a fused IMU state (its velocity and biases seed the VIS).
+  // The newest LIS sweep with a fused IMU state (its velocity and biases seed the VIS), and the LIS's request to
+  // reset the VIS (ScanOutcome::vis_reset), which is done and recorded as an event.
   void onLisState(const pipeline::ScanOutcome& outcome);
 
   // The VIS's state after the newest frame, once (for the LIS's VIS fusion, LidarOdometry::addVisualState);
@@ -66,6 +70,7 @@ class RunVis {
 
  private:
   std::optional<vio::SeedState> seedAt(Time t, const pipeline::LidarOdometry& lis) const;
+  void noteReset(Time t, const std::string& why);
 
   std::unique_ptr<vio::VisualOdometry> own_;
   const vio::VisualOdometry* vo_ = nullptr;  // own_, or the System's

@@ -18,7 +18,8 @@
 //   DIR/groundtruth.txt         TUM `t x y z qx qy qz qw` [s, m], T_world_imu at ground_truth.rate_hz (>= 100 Hz)
 //   DIR/scenario.json           {format_version, generator, scenario, seed, duration_s, path_length_m, closes_loop,
 //                                lidar_model, sensors {imu, lidar, camera: bool},
-//                                segments [{condition, start_ns, end_ns}]}
+//                                segments [{condition, start_ns, end_ns}],
+//                                faults [{kind, start_ns, end_ns}] (optional: injected sensor faults)}
 // All stamps are int64 ns on the IMU clock's epoch as each sensor reports them: a sensor stamp is
 // t_true - offset, i.e. t_imu = t_sensor + offset with the offsets of calibration.yaml. A disabled sensor keeps
 // its folder with a header-only timestamps.csv (imu.csv likewise), so the layout never changes.
@@ -96,6 +97,7 @@ struct SimScenarioInfo {
   std::string generator = "drover sim";  // generator name and version
   bool has_imu = true, has_lidar = true, has_camera = true;
   std::vector<SimSegmentInfo> segments;
+  std::vector<SimSegmentInfo> faults;  // injected sensor faults: kind ("camera-blackout", ...) and window [ns]
 };
 
 // One ground-truth sample of the simulated body (= IMU) with its exact twist, on the simulation's clock (the bag's

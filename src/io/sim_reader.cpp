@@ -198,6 +198,11 @@ void readScenarioJson(const fs::path& path, SimDatasetDescription& d) {
   for (const auto& seg : jsonValue<nlohmann::json>(j, "segments", file))
     s.segments.push_back({jsonValue<std::string>(seg, "condition", file), jsonValue<Time>(seg, "start_ns", file),
                           jsonValue<Time>(seg, "end_ns", file)});
+  s.faults.clear();
+  if (j.contains("faults"))
+    for (const auto& f : jsonValue<nlohmann::json>(j, "faults", file))
+      s.faults.push_back({jsonValue<std::string>(f, "kind", file), jsonValue<Time>(f, "start_ns", file),
+                          jsonValue<Time>(f, "end_ns", file)});
 }
 
 // ---- csv indexes -----------------------------------------------------------------------------------------------

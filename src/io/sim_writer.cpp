@@ -80,6 +80,9 @@ std::string scenarioJson(const SimDatasetDescription& d) {
   j["segments"] = nlohmann::ordered_json::array();
   for (const SimSegmentInfo& seg : s.segments)
     j["segments"].push_back({{"condition", seg.condition}, {"start_ns", seg.start}, {"end_ns", seg.end}});
+  // Only with faults, so that a dataset without them stays byte-identical to one from before faults existed.
+  for (const SimSegmentInfo& f : s.faults)
+    j["faults"].push_back({{"kind", f.condition}, {"start_ns", f.start}, {"end_ns", f.end}});
   return j.dump(2) + "\n";
 }
 

@@ -37,7 +37,8 @@ ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_im
       propagator_(config.propagator),
       initializer_(config.initializer),
       smoother_(config.smoother),
-      visual_(config.vis_fusion, config.preintegration) {}
+      visual_(config.vis_fusion, config.preintegration),
+      visual_watch_(config.vis_fusion.reset_after) {}
 
 imu::SampleStatus ImuFusion::addImu(const ImuSample& sample) { return propagator_.addSample(sample); }
 
@@ -160,12 +161,14 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   std::optional<backend::RelativePoseMeasurement> visual;
   if (config_.vis_fusion.factor && !visual_.empty()) {
     std::string why;
-    if (const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, out.t, &why)) {
+    bool disagreed = false;
+    if (const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, out.t, &why, &disagreed)) {
       visual = backend::RelativePoseMeasurement{inc->T_a_b, inc->sqrt_information};
       out.vis_factor = true;
     } else {
       out.vis_unused = why;
     }
+    out.vis_reset = visual_watch_.onSweep(out.t, out.vis_factor, disagreed ? why : std::string());
   }
   backend::SmootherUpdate r;
   try {
@@ -207,13 +210,15 @@ std::optional<Eigen::Isometry3d> ImuFusion::visualLidarGuess(Time t, const Stamp
 
 // The VIS's motion between a and b while it agrees with the IMU's prediction from the newest fused state (the
 // propagation starts there; a is that state's stamp).
-std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b, std::string* why) const {
+std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b, std::string* why,
+                                                                 bool* disagreed) const {
   std::optional<VisualIncrement> inc = visual_.increment(a, b, propagator_, why);
   if (!inc) return std::nullopt;
   const std::optional<imu::NavState> xa = propagator_.stateAt(a), xb = propagator_.stateAt(b);
   if (!xa || !xb) return inc;  // no prediction to hold it against (the smoother restarts)
   if (std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion); !d.empty()) {
     if (why != nullptr) *why = std::move(d);
+    if (disagreed != nullptr) *disagreed = true;
     return std::nullopt;
   }
   return inc;

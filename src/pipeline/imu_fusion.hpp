@@ -79,7 +79,9 @@ class ImuFusion {
   void restart(const imu::NavState& state, const imu::ImuBias& bias,
                const std::optional<Eigen::Matrix3d>& gyro_bias_covariance = std::nullopt,
                const std::optional<Eigen::Matrix<double, 6, 6>>& bias_covariance = std::nullopt);
-  std::optional<VisualIncrement> checkedVisualIncrement(Time a, Time b, std::string* why) const;
+  // `disagreed` (optional) is set when a VIS increment existed but the gates refused it.
+  std::optional<VisualIncrement> checkedVisualIncrement(Time a, Time b, std::string* why,
+                                                        bool* disagreed = nullptr) const;
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
 
   OdometryConfig config_;
@@ -88,6 +90,7 @@ class ImuFusion {
   imu::StaticInitializer initializer_;
   backend::FixedLagSmoother smoother_;
   VisualMotion visual_;
+  VisualWatch visual_watch_;
   bool initialized_ = false, given_up_ = false;
   std::string init_note_ = "no IMU data";
   Eigen::Isometry3d T_world_imu0_ = Eigen::Isometry3d::Identity();

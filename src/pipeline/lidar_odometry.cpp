@@ -71,7 +71,10 @@ Trajectory LidarOdometry::keyframeTrajectory() const {
 
 void LidarOdometry::setSweepListener(SweepListener listener) { impl_->sweep_listener = std::move(listener); }
 
-void LidarOdometry::addVisualState(const VisualState& state) { impl_->fusion.addVisualState(state); }
+void LidarOdometry::addVisualState(const VisualState& state) {
+  impl_->fusion.addVisualState(state);
+  if (impl_->config.loop.visual_yaw_prior && !impl_->external_loops) impl_->visual_yaw.add(state);
+}
 
 void LidarOdometry::setKeyframeListener(KeyframeListener listener, bool external_loops) {
   impl_->keyframe_listener = std::move(listener);

@@ -41,6 +41,7 @@ struct ScanOutcome {
   bool vis_guess = false;         // the matcher's guess was the VIS's motion since the previous sweep
   bool vis_factor = false;        // the VIS's motion entered the IMU smoother as a relative-pose factor
   std::string vis_unused;         // why not, while a VIS runs (empty when it was used or none runs)
+  std::string vis_reset;          // the LIS asks the VIS to reset, and why (vis_fusion.reset_after); else empty
   std::string match_status;       // lidar::toString(MatchStatus), "first" for the first sweep
   std::string match_reason;       // the matcher's one-line reason
   bool converged = false;
@@ -80,6 +81,7 @@ struct OdometryStats {
   std::size_t imu_scans = 0;             // sweeps deskewed and predicted with the IMU
   std::size_t vis_guess_scans = 0;       // sweeps whose matcher guess was the VIS's motion
   std::size_t vis_factor_scans = 0;      // sweeps whose smoother update had the VIS's motion as a factor
+  std::size_t vis_resets_requested = 0;  // sweeps that asked the VIS to reset (ScanOutcome::vis_reset)
   bool imu_initialized = false;
   std::string imu_init;                  // how the IMU was initialised (or why not)
   imu::ImuStreamStats imu;

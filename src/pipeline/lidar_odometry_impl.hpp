@@ -9,6 +9,7 @@
 #include "pipeline/imu_fusion.hpp"
 #include "pipeline/imu_stream_notices.hpp"
 #include "pipeline/lidar_odometry.hpp"
+#include "pipeline/visual_yaw_history.hpp"
 
 namespace drover::pipeline {
 
@@ -30,6 +31,7 @@ struct LidarOdometry::Impl {
   Eigen::Isometry3d T_world_lastkf = Eigen::Isometry3d::Identity();
   OdometryStats stats;
   LoopClosure loops;
+  VisualYawHistory visual_yaw;  // the VIS's attitude: loop closure's shift prior (config.loop.visual_yaw_prior)
   // Per processed sweep: the keyframe it followed and its pose relative to it, so a loop correction of the
   // keyframes carries every sweep with it and the trajectory is the keyframes' poses times these. Compact (80
   // bytes, not a world pose and an anchor's 272): an hour of sweeps at 10 Hz is 2.9 MB, not 9.8 MB.
@@ -60,7 +62,10 @@ struct LidarOdometry::Impl {
         matcher(c.matcher),
         policy(c.keyframes),
         fusion(c, calib.T_imu_lidar),
-        loops(c.loopClosure()) {}
+        loops(c.loopClosure()),
+        visual_yaw(calib.T_imu_lidar) {
+    if (c.loop.visual_yaw_prior) loops.setVisualYawPrior(visual_yaw.prior());
+  }
 
   std::vector<ScanOutcome> onScan(LidarScan scan);
   std::vector<ScanOutcome> drain(bool force);

@@ -95,6 +95,7 @@ std::optional<ScanOutcome> LidarOdometry::Impl::processScan(LidarScan& scan) {
   if (out.imu_used) ++stats.imu_scans;
   if (out.vis_guess) ++stats.vis_guess_scans;
   if (out.vis_factor) ++stats.vis_factor_scans;
+  if (!out.vis_reset.empty()) ++stats.vis_resets_requested;
 
   accumulateDegeneracy(out);
   if (sweep_listener) sweep_listener(scan.t, out.T_world_lidar, features.full);

@@ -161,14 +161,15 @@ std::vector<Candidate> LoopClosure::Impl::candidates(const lidar::LocalMap& map,
   if (config.source != LoopSource::kRadius) {
     auto t0 = Clock::now();
     auto prior = [&](int id) -> std::optional<loop::YawPrior> {
+      const std::size_t candidate = static_cast<std::size_t>(id);
       if (visual_prior) {
-        if (std::optional<double> v = visual_prior(times[static_cast<std::size_t>(id)], times[index])) {
+        if (std::optional<double> v = visual_prior(times[candidate], times[index])) {
           ++stats.visual_priors;
-          return v;
+          // The VIS drifts in yaw with the path as the estimate does, but lidar degeneracy does not touch it.
+          return loop::YawPrior(*v, shiftFallbackRadius(config, path_before[index] - path_before[candidate], 0.0));
         }
       }
       if (!config.yaw_prior) return std::nullopt;
-      const std::size_t candidate = static_cast<std::size_t>(id);
       return loop::YawPrior(
           geometry::yawOf(map.keyframe(candidate).T_world_lidar.linear().transpose() * T_world_query.linear()),
           shiftFallbackRadius(config, path_before[index] - path_before[candidate],

@@ -39,13 +39,16 @@ struct LoopClosureConfig {
   loop::ScanContextDatabaseConfig database;  // descriptor (rings, sectors, radius, sensor height, threshold, dh)
   loop::LoopVerifierConfig verifier;
   bool yaw_prior = true;                  // narrow the shift search around the estimate's relative yaw (Eqs. 2-4)
+  // While a VIS runs: narrow it around the VIS's relative yaw instead when the VIS tracked through both keyframes'
+  // times without a reset (pipeline::VisualYawHistory, LVI-SAM's A +- dh), the estimate's otherwise.
+  bool visual_yaw_prior = true;
   // The narrowed search's fall-back when the window's best fails the threshold. kAlways: the full search (the
   // paper's; every candidate that is another place then pays for both, 7 + 60 shifts per descriptor). kBudget: only
   // the shifts the rotation drift budget since the candidate allows (below, charged along the keyframe chain, so
   // never less than the acceptance check's), plus one sector for the descriptor's quantisation: a loop further off
   // the estimate's yaw would be refused by that budget anyway. With the defaults that is +-4 sectors after 19 m of
-  // path, +-8 after 1 km, all 60 where the odometry was degenerate in rotation. A VisualYawPrior keeps the full
-  // fall-back: the budget bounds the estimate's drift, not the VIS's. kNever: the window only (a true revisit whose
+  // path, +-8 after 1 km, all 60 where the odometry was degenerate in rotation. A VisualYawPrior gets the budget
+  // without the degenerate term (the VIS's yaw drifts with the path, and lidar degeneracy does not touch it). kNever: the window only (a true revisit whose
   // estimate drifted more than the window misses). Sectors: 2 pi / database.descriptor.sectors each.
   ShiftFallback shift_fallback = ShiftFallback::kBudget;
   double min_age = 30.0;                  // [s] candidates at least this much older than the query (LIO-SAM 30 s)

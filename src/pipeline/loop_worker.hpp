@@ -26,6 +26,8 @@ class LoopWorker {
   // [bytes] the keyframes' feature clouds only it holds (it shares the LIS's: 0 while the LIS lives)
   std::size_t keyframeBytes() const;
   const LoopClosure& loopClosure() const { return loops_; }
+  // The VIS's relative yaw for the shift search (LoopClosure::setVisualYawPrior); call before the first add().
+  void setVisualYawPrior(VisualYawPrior prior) { loops_.setVisualYawPrior(std::move(prior)); }
 
  private:
   std::optional<LoopCorrection> search(const KeyframeRecord& keyframe);

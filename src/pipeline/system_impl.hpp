@@ -15,6 +15,7 @@
 #include "pipeline/lis_seed.hpp"
 #include "pipeline/live_queue.hpp"
 #include "pipeline/loop_worker.hpp"
+#include "pipeline/visual_yaw_history.hpp"
 #include "pipeline/stream_clock.hpp"
 #include "pipeline/system.hpp"
 
@@ -53,6 +54,7 @@ struct System::Impl {
   SystemCallbacks cb;
   LidarOdometry lis;
   std::unique_ptr<LoopWorker> loops;
+  std::unique_ptr<VisualYawHistory> visual_yaw;  // the VIS thread adds, the loop thread asks (thread-safe)
   std::unique_ptr<vio::VisualOdometry> vo;
 
   // IMU front: the pushing thread's propagation, re-anchored on the LIS's fused state.
@@ -74,6 +76,7 @@ struct System::Impl {
   // each measurement. States that arrive after their sweep was fused are simply not used for it (late is late).
   std::mutex visual_mutex;
   std::vector<VisualState> visual_states;
+  std::string vis_reset_request;  // the LIS asks the VIS thread to reset (ScanOutcome::vis_reset); visual_mutex
   VisualStateStream visual_stream;  // VIS thread only
 
   LiveQueue<Measurement> lis_queue;
@@ -109,6 +112,10 @@ struct System::Impl {
       vio::VisConfig vis = *c.vis;
       vis.tracker.async_detection = true;
       vo = std::make_unique<vio::VisualOdometry>(vis, calibration, c.odometry.preintegration, std::move(detector));
+    }
+    if (loops && vo && c.odometry.loop.visual_yaw_prior) {
+      visual_yaw = std::make_unique<VisualYawHistory>(calibration.T_imu_lidar);
+      loops->setVisualYawPrior(visual_yaw->prior());
     }
     lis.setKeyframeListener([this](const KeyframeRecord& k) { onKeyframe(k); }, loops != nullptr);
     if (vo || cb.deskewed_sweep)

@@ -54,6 +54,11 @@ void System::Impl::lisLoop() {
       outcomes = lis.process(*m);
       notices = takeNotices();
     }
+    for (const ScanOutcome& o : outcomes)
+      if (!o.vis_reset.empty()) {
+        std::lock_guard<std::mutex> lock(visual_mutex);
+        vis_reset_request = o.vis_reset;
+      }
     for (const std::string& n : notices) warn("LIS: " + n);
     const bool done_sweep = !outcomes.empty();
     publish(std::move(outcomes));
@@ -187,9 +192,21 @@ void System::Impl::visFrame(const CameraFrame& frame) {
         return lisSeedAt(imu_rate, t, *lis_bias);
       };
   }
+  std::string reset_by_lis;
+  {
+    std::lock_guard<std::mutex> lock(visual_mutex);
+    reset_by_lis.swap(vis_reset_request);
+  }
+  if (!reset_by_lis.empty() && vo->estimator().initialized()) vo->reset();
+  else reset_by_lis.clear();
   try {
-    const vio::VisFrame f = vo->addFrame(frame, pose_at, seed);
+    vio::VisFrame f = vo->addFrame(frame, pose_at, seed);
+    if (!reset_by_lis.empty() && !f.estimate.reset) {  // reported as the VIS's own resets are (RunVis::record)
+      f.estimate.reset = true;
+      f.estimate.event = "reset by the LIS: " + reset_by_lis;
+    }
     if (const std::optional<VisualState> v = visual_stream.onFrame(f.estimate); v && config.use_lidar) {
+      if (visual_yaw) visual_yaw->add(*v);
       std::lock_guard<std::mutex> lock(visual_mutex);
       visual_states.push_back(*v);
     }

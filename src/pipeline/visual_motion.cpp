@@ -21,6 +21,7 @@ std::string VisualMotionConfig::validate() const {
   for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position_ratio", sigma_position_ratio},
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
                                 {"warmup", warmup},
+                                {"reset_after", reset_after},
                                 {"standing_speed", standing_speed}})
     if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
   if (min_features < 1 || full_features < min_features)
@@ -143,6 +144,22 @@ std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState&
   if (dp > config.max_position_difference)
     return fmt::format("the VIS's motion differs from the IMU's prediction by {:.2f} m", dp);
   return {};
+}
+
+}  // namespace drover::pipeline
+
+namespace drover::pipeline {
+
+std::string VisualWatch::onSweep(Time t, bool used, const std::string& refused) {
+  if (reset_after_ <= 0 || used || refused.empty()) {
+    since_.reset();
+    return {};
+  }
+  if (!since_) since_ = t;
+  if (t - *since_ < reset_after_) return {};
+  const double lasted = toSeconds(t - *since_);
+  since_.reset();
+  return fmt::format("the LIS refused the VIS for {:.1f} s ({})", lasted, refused);
 }
 
 }  // namespace drover::pipeline

@@ -45,8 +45,11 @@ struct VisualMotionConfig {
   double standing_speed = 0.2;            // [m/s]
   double max_velocity_difference = 1.0;   // [m/s] body-frame velocity at the later stamp
   double max_position_difference = 0.5;   // [m] translation between the stamps
+  // A VIS the gates above refused for this long in a row is asked to reset (it then re-initialises from the LIS):
+  // on a textureless stretch of the corridor it stalled, was refused for 5 s, and re-joined 4 m behind. 0: never.
+  double reset_after = 1.5;               // [s]
   // Empty when valid: sigmas and ratios finite (sigmas > 0, ratios >= 0), 0 < min_features <= full_features,
-  // warmup >= 0, max_age > 0.
+  // warmup >= 0, max_age > 0, reset_after >= 0.
   std::string validate() const;
 };
 
@@ -113,6 +116,21 @@ class VisualMotion {
   VisualMotionConfig config_;
   imu::PreintegrationConfig imu_;
   std::deque<VisualState> states_;
+};
+
+// The LIS's half of "the failing side resets and re-joins" (LVI-SAM re-initialises a failed VIS from the LIS):
+// a VIS that runs and is past its warm-up, but which the gates of disagreementWithImu refuse at every sweep for
+// reset_after seconds, is asked to reset once; the count starts again after it.
+class VisualWatch {
+ public:
+  explicit VisualWatch(double reset_after_s) : reset_after_(fromSeconds(reset_after_s)) {}
+  // One sweep at t: the VIS was used, or refused by a gate (`refused` says why), or had no usable state (neither).
+  // Returns why the VIS should reset, once the refusals have lasted reset_after; else empty.
+  std::string onSweep(Time t, bool used, const std::string& refused);
+
+ private:
+  Time reset_after_;
+  std::optional<Time> since_;
 };
 
 }  // namespace drover::pipeline

@@ -86,12 +86,14 @@ class CameraRenderer {
   // blur, sub-frame i of N is at t + exposure * ((i + 0.5) / N - 0.5), clamped to the trajectory's span.
   // An empty `illumination` means uniform daylight (1). Throws std::out_of_range when t is outside the trajectory.
   CameraFrame render(const World& world, const SplineTrajectory& trajectory, const Eigen::Isometry3d& T_body_cam,
-                     const Illumination& illumination, Time t, std::uint64_t seed, std::uint64_t frame_index) const;
+                     const Illumination& illumination, Time t, std::uint64_t seed, std::uint64_t frame_index,
+                     bool textureless = false) const;
   // The scene before any sensor: ideal grey per pixel, motion blur (if configured) over `exposure_s` [s] centred on
-  // t. Deterministic (no noise). Throws std::out_of_range when t is outside the trajectory.
+  // t. Deterministic (no noise). Throws std::out_of_range when t is outside the trajectory. textureless: every
+  // surface in its plain colour (the sensor-fault of sensor_faults.hpp).
   RadianceImage renderRadiance(const World& world, const SplineTrajectory& trajectory,
                                const Eigen::Isometry3d& T_body_cam, const Illumination& illumination, Time t,
-                               double exposure_s) const;
+                               double exposure_s, bool textureless = false) const;
   const CameraModelConfig& config() const { return config_; }
 
   // Pixel [px] of a camera-frame point: distort + K. Nothing when the point is not in front of the camera
@@ -106,7 +108,7 @@ class CameraRenderer {
  private:
   struct SubFrame;
   void renderRow(const World& world, const std::vector<SubFrame>& subframes, const Illumination& illumination,
-                 int v, float* row) const;
+                 int v, float* row, bool textureless) const;
 
   CameraModelConfig config_;
   std::size_t width_ = 0;

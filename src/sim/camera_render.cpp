@@ -29,12 +29,18 @@ float lightAt(const Illumination& illumination, Time t, const Eigen::Vector3d& p
 }
 
 // Linear RGB arriving along one camera ray at one sub-frame.
+// textureless: the surface's plain colour (the white-walls material with the surface's colour) instead of its texture.
 Eigen::Vector3f radiance(const World& world, const Illumination& illumination, const Eigen::Vector3f& sky,
                          Time t, const Eigen::Matrix3d& R_world_cam, const Eigen::Vector3d& origin_world,
-                         const Eigen::Vector3d& ray_cam) {
+                         const Eigen::Vector3d& ray_cam, bool textureless) {
   const Ray ray{origin_world, R_world_cam * ray_cam};
   if (const std::optional<Hit> hit = world.intersect(ray)) {
     const float light = lightAt(illumination, t, hit->point) * lambertFactor(hit->normal);
+    if (textureless) {
+      Material plain = *hit->material;
+      plain.texture = Texture::kWhite;
+      return shade(plain, hit->uv) * light;
+    }
     return shade(*hit->material, hit->uv) * light;
   }
   return sky * lightAt(illumination, t, ray.origin + kSkyDistance * ray.direction);
@@ -43,7 +49,7 @@ Eigen::Vector3f radiance(const World& world, const Illumination& illumination, c
 }  // namespace
 
 void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& subframes,
-                               const Illumination& illumination, int v, float* row) const {
+                               const Illumination& illumination, int v, float* row, bool textureless) const {
   const int width = config_.intrinsics.width;
   const float inv_samples = 1.0f / static_cast<float>(subframes.size());
   for (int u = 0; u < width; ++u) {
@@ -51,7 +57,7 @@ void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& 
     const Eigen::Vector3d ray_cam = rays_cam_[pixel].cast<double>();
     Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
     for (const SubFrame& s : subframes) {
-      rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam);
+      rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless);
     }
     rgb *= inv_samples * 255.0f;
     if (!config_.color) {
@@ -64,7 +70,7 @@ void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& 
 
 RadianceImage CameraRenderer::renderRadiance(const World& world, const SplineTrajectory& trajectory,
                                              const Eigen::Isometry3d& T_body_cam, const Illumination& illumination,
-                                             Time t, double exposure_s) const {
+                                             Time t, double exposure_s, bool textureless) const {
   const int samples = config_.motion_blur_samples;
   const double exposure_ns = exposure_s * 1e9;
   std::vector<SubFrame> subframes(static_cast<std::size_t>(samples));
@@ -84,15 +90,17 @@ RadianceImage CameraRenderer::renderRadiance(const World& world, const SplineTra
   const std::size_t stride = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.channels);
   image.grey.resize(stride * static_cast<std::size_t>(image.height));
   tbb::parallel_for(tbb::blocked_range<int>(0, image.height), [&](const tbb::blocked_range<int>& rows) {
-    for (int v = rows.begin(); v != rows.end(); ++v) renderRow(world, subframes, illumination, v, image.grey.data() + stride * v);
+    for (int v = rows.begin(); v != rows.end(); ++v) 
+      renderRow(world, subframes, illumination, v, image.grey.data() + stride * v, textureless);
   });
   return image;
 }
 
 CameraFrame CameraRenderer::render(const World& world, const SplineTrajectory& trajectory,
                                    const Eigen::Isometry3d& T_body_cam, const Illumination& illumination, Time t,
-                                   std::uint64_t seed, std::uint64_t frame_index) const {
-  const RadianceImage radiance = renderRadiance(world, trajectory, T_body_cam, illumination, t, config_.exposure_s);
+                                   std::uint64_t seed, std::uint64_t frame_index, bool textureless) const {
+  const RadianceImage radiance =
+      renderRadiance(world, trajectory, T_body_cam, illumination, t, config_.exposure_s, textureless);
   CameraFrame frame;
   frame.t = t;
   frame.camera_id = 0;

@@ -11,15 +11,22 @@
 
 namespace drover::sim {
 
+// What a sensor fault does to one frame (sensor_faults.hpp).
+struct FrameCondition {
+  bool blackout = false;     // no light reaches the sensor
+  bool textureless = false;  // surfaces in their plain colours
+};
+
 class CameraStream {
  public:
   // Throws std::invalid_argument when config.validate() fails.
   explicit CameraStream(const CameraModelConfig& config);
   // The next frame, exposed (mid-exposure) at true time t; frame_index counts from 0 and seeds the noise with
   // `seed`. The first frame settles the auto exposure on its own scene before it is taken. Motion blur spans the
-  // frame's own exposure time.
+  // frame's own exposure time. A blacked-out frame meters as black, so the auto exposure opens up during it.
   CameraFrame next(const World& world, const SplineTrajectory& trajectory, const Eigen::Isometry3d& T_body_cam,
-                   const Illumination& illumination, Time t, std::uint64_t seed, std::uint64_t frame_index);
+                   const Illumination& illumination, Time t, std::uint64_t seed, std::uint64_t frame_index,
+                   FrameCondition condition = {});
   // The setting the last frame was taken with (the ideal camera: config exposure_s, gain 1).
   const ExposureSetting& lastSetting() const { return last_; }
   bool lastAtFloor() const { return last_at_floor_; }

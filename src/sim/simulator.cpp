@@ -91,6 +91,8 @@ std::string SimulatorConfig::validate() const {
     e << "T_imu_lidar is not a rigid transform";
   } else if (!isRigid(T_imu_cam)) {
     e << "T_imu_cam is not a rigid transform";
+  } else if (std::string f = validateFaults(faults); !f.empty()) {
+    e << f;
   } else if (std::abs(lidar_time_offset) > kNanosPerSecond || std::abs(camera_time_offset) > kNanosPerSecond) {
     e << "time offsets must be within 1 s, got lidar " << lidar_time_offset << " ns, camera " << camera_time_offset
       << " ns";
@@ -151,13 +153,22 @@ std::vector<Time> Simulator::frameTimes() const {
   return t;
 }
 
+bool Simulator::sweepDropped(Time t0) const {
+  const Time period = static_cast<Time>(std::llround(1e9 / config_.lidar.rate_hz));
+  return faulted(config_.faults, FaultKind::kLidarDropout, t0, t0 + period);
+}
+
 Simulator::Counts Simulator::expectedCounts() const {
   Counts c;
   if (config_.enable_imu) {
     const Time start = scenario_.trajectory->startTime(), end = scenario_.trajectory->endTime();
-    while (periodic(start, c.imu, config_.imu.rate_hz) <= end) ++c.imu;
+    for (std::size_t k = 0;; ++k) {
+      const Time t = periodic(start, k, config_.imu.rate_hz);
+      if (t > end) break;
+      if (!faulted(config_.faults, FaultKind::kImuGap, t)) ++c.imu;
+    }
   }
-  c.lidar = sweepStarts().size();
+  for (Time t0 : sweepStarts()) c.lidar += sweepDropped(t0) ? 0 : 1;
   c.camera = frameTimes().size();
   return c;
 }
@@ -177,8 +188,14 @@ void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) 
   std::optional<CameraStream> camera;
   if (config_.enable_camera) camera.emplace(config_.camera);
 
-  const std::vector<Slot> schedule =
+  std::vector<Slot> schedule =
       buildSchedule(imu, sweeps, frames, config_.lidar_time_offset, config_.camera_time_offset);
+  // Faults drop slots, never renumber them: every sample outside a fault keeps its index and so its noise.
+  std::erase_if(schedule, [&](const Slot& s) {
+    if (s.sensor == 0) return faulted(config_.faults, FaultKind::kImuGap, imu[s.index].t);
+    if (s.sensor == 1) return sweepDropped(sweeps[s.index]);
+    return false;
+  });
   const auto sweep = [&](const Slot& s) -> Measurement {
     LidarScan scan = simulateSweep(scenario_.world, trajectory, config_.T_imu_lidar, sweeps[s.index], config_.lidar,
                                    lidar_seed, s.index);
@@ -188,8 +205,11 @@ void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) 
     return scan;
   };
   const auto frame = [&](const Slot& s) -> Measurement {
-    CameraFrame f = camera->next(scenario_.world, trajectory, config_.T_imu_cam, scenario_.illumination,
-                                 frames[s.index], camera_seed, s.index);
+    const Time t = frames[s.index];
+    const FrameCondition condition{faulted(config_.faults, FaultKind::kCameraBlackout, t),
+                                   faulted(config_.faults, FaultKind::kTextureless, t)};
+    CameraFrame f = camera->next(scenario_.world, trajectory, config_.T_imu_cam, scenario_.illumination, t,
+                                 camera_seed, s.index, condition);
     f.t = s.stamp;
     return f;
   };
@@ -256,6 +276,7 @@ io::SimDatasetDescription Simulator::datasetDescription() const {
   sc.has_camera = config_.enable_camera;
   for (const Segment& seg : scenario_.segments)
     sc.segments.push_back({conditionName(seg.condition), seg.start, seg.end});
+  for (const SensorFault& f : config_.faults) sc.faults.push_back({faultName(f.kind), f.start, f.end});
   return d;
 }
 

@@ -11,6 +11,7 @@
 #include "sim/imu_model.hpp"
 #include "sim/lidar_model.hpp"
 #include "sim/scenario.hpp"
+#include "sim/sensor_faults.hpp"
 #include "types/calibration.hpp"
 #include "types/measurement.hpp"
 #include "types/trajectory.hpp"
@@ -40,6 +41,8 @@ struct SimulatorConfig {
   Time lidar_time_offset = 0;    // [ns]
   Time camera_time_offset = 0;   // [ns]; defaults() sets 5 ms (camera stamps 5 ms early)
   double ground_truth_rate_hz = 200.0;  // [Hz], >= 100
+  // Injected sensor faults (sensor_faults.hpp), windows in true time; the ground truth is complete regardless.
+  std::vector<SensorFault> faults;
   // The above with the robot's default extrinsics, offsets and camera intrinsics filled in.
   static SimulatorConfig defaults();
   std::string validate() const;  // empty when valid, else names the bad value
@@ -65,13 +68,14 @@ class Simulator {
   struct Counts {
     std::size_t imu = 0, lidar = 0, camera = 0;
   };
-  Counts expectedCounts() const;
+  Counts expectedCounts() const;  // after the faults' drops
   // What the dataset writer needs besides the measurements: calibration, sensor settings, scenario labels.
   io::SimDatasetDescription datasetDescription() const;
 
  private:
   std::vector<Time> sweepStarts() const;  // true start times [ns]
   std::vector<Time> frameTimes() const;   // true mid-exposure times [ns]
+  bool sweepDropped(Time t0) const;        // a lidar-dropout overlaps the sweep starting (true time) at t0
 
   const Scenario& scenario_;
   SimulatorConfig config_;

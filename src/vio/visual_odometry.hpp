@@ -59,6 +59,9 @@ class VisualOdometry {
   // skips it).
   VisFrame addFrame(const CameraFrame& frame, const PoseAt& lis_pose, const Seeder& seed);
   const SlidingWindowEstimator& estimator() const { return estimator_; }
+  // The LIS asks the VIS to start again (its gates refused it too long, pipeline::VisualWatch): the window is
+  // cleared and re-initialises from the LIS's state at the next frames; the tracker's features carry on.
+  void reset() { estimator_.reset(); }
   void setRealtime(bool realtime) { estimator_.setRealtime(realtime); }
 
  private:

@@ -108,6 +108,39 @@ TEST(VisRun, BesideTheLisTheVisStartsFromItAndUsesLidarDepth) {
   EXPECT_TRUE(std::filesystem::exists(dir / "lvi" / "trajectory.tum"));  // the LIS's, as without a camera
 }
 
+// The paper's comparison: --preset lvi-sam runs LVI-SAM's methods over the platform file (radius loops, no VO factor,
+// fixed lidar depth, Shi-Tomasi) and says so in report.json; --without takes one part out after a preset.
+TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePartsTakenOut) {
+  TempDir dir;
+  const CliResult sim = simulate(dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const std::string base = "run " + (dir / "straight").string() + " --format sim --config " +
+                           shiTomasiConfig("farm_sim.yaml", dir.path());
+  const CliResult lvi = runDrover(base + " -q --preset lvi-sam --out " + (dir / "lvi").string());
+  ASSERT_EQ(lvi.exit_code, 0) << lvi.output;
+  const Json r = readJson(dir / "lvi" / "report.json");
+  EXPECT_EQ(r["preset"], "lvi-sam");
+  EXPECT_EQ(r["loops"]["source"], "radius");
+  EXPECT_EQ(r["vis"]["depth_mode"], "fixed");
+  EXPECT_EQ(r["vis"]["detector"], "shi-tomasi");
+  EXPECT_EQ(r["counts"]["vis_factor_scans"], 0) << "LVI-SAM's released code has no visual odometry factor";
+  EXPECT_GT(r["counts"]["vis_guess_scans"].get<int>(), 20);
+  const CliResult nf = runDrover(base + " -q --no-loop --preset drover --without superpoint --without vo-factor "
+                                 "--out " + (dir / "nf").string());
+  ASSERT_EQ(nf.exit_code, 0) << nf.output;
+  const Json n = readJson(dir / "nf" / "report.json");
+  EXPECT_EQ(n["preset"], "drover without superpoint, vo-factor");
+  EXPECT_EQ(n["vis"]["depth_mode"], "factor");
+  EXPECT_EQ(n["counts"]["vis_factor_scans"], 0);
+  const CliResult bad = runDrover(base + " --preset vins --out " + (dir / "bad").string());
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--preset"), std::string::npos) << bad.output;
+  const CliResult part = runDrover(base + " --without loops --out " + (dir / "bad").string());
+  EXPECT_EQ(part.exit_code, 2) << part.output;
+  EXPECT_NE(part.output.find("--without"), std::string::npos) << part.output;
+  EXPECT_FALSE(fs::exists(dir / "bad"));
+}
+
 TEST(VisRunRefuses, NoLidarWithNoCameraIsAnErrorBeforeAnyWork) {
   TempDir dir;
   const CliResult r = runDrover("run " + dir.path().string() + " --format sim --no-lidar --no-camera --out " +

@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -61,6 +62,31 @@ TEST(SimCli, LidarModelAndNoCameraAreHonoured) {
   const Json j = readJson(dir / "info.json");
   EXPECT_EQ(j["camera"]["count"], 0);
   EXPECT_GT(j["lidar"]["count"].get<int>(), 0);
+}
+
+TEST(SimCli, FaultsAreWrittenIntoScenarioJsonAndBadOnesExitWithCode2NamingTheOption) {
+  TempDir dir;
+  const fs::path out = dir / "faults";
+  const CliResult r = runDrover("sim -q --scenario straight --duration 3 --no-camera --fault imu-gap@1+0.5 "
+                                "--fault lidar-dropout@2+0.25 --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json j = readJson(out / "scenario.json");
+  ASSERT_EQ(j["faults"].size(), 2u);
+  EXPECT_EQ(j["faults"][0]["kind"], "imu-gap");
+  EXPECT_EQ(j["faults"][0]["end_ns"].get<std::int64_t>() - j["faults"][0]["start_ns"].get<std::int64_t>(), 500'000'000);
+  EXPECT_EQ(j["faults"][1]["kind"], "lidar-dropout");
+  const CliResult info = runDrover("info " + out.string() + " --format sim --json " + (dir / "info.json").string());
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const Json k = readJson(dir / "info.json");
+  EXPECT_EQ(k["lidar"]["count"].get<int>(), 30 - 3);  // sweeps starting at 2.0, 2.1 and 2.2 s
+  EXPECT_EQ(k["imu"]["count"].get<int>(), 601 - 100);
+  for (const char* bad : {"camera-off@1+1", "imu-gap@1", "imu-gap@x+1", "imu-gap@1+0", "imu-gap@1+-2", "imu-gap@99+1"}) {
+    const CliResult e = runDrover(std::string("sim -q --scenario straight --duration 3 --no-camera --fault ") + bad +
+                                  " --out " + (dir / "bad").string());
+    EXPECT_EQ(e.exit_code, 2) << bad << ": " << e.output;
+    EXPECT_NE(e.output.find("--fault"), std::string::npos) << bad << ": " << e.output;
+    EXPECT_FALSE(fs::exists(dir / "bad")) << bad;
+  }
 }
 
 TEST(SimCli, UnknownScenarioExitsWithCode2AndOneLine) {

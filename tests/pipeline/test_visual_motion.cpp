@@ -70,6 +70,34 @@ VisualMotion motionWithFrames(Time until, const VisualMotionConfig& config = {})
   return m;
 }
 
+
+TEST(VisualWatch, AVisRefusedAtEverySweepForResetAfterIsAskedToResetOnceAndTheCountStartsAgain) {
+  VisualWatch watch(1.5);
+  const std::string why = "the VIS made no keyframe for 2.0 s while moving at 1.00 m/s";
+  std::vector<int> asked;
+  for (int k = 0; k <= 40; ++k) {  // 10 Hz sweeps, refused from 0 s to 4 s
+    const std::string r = watch.onSweep(k * kSec / 10, false, why);
+    if (!r.empty()) {
+      asked.push_back(k);
+      EXPECT_NE(r.find("1.5 s"), std::string::npos) << r;
+      EXPECT_NE(r.find(why), std::string::npos) << r;
+    }
+  }
+  EXPECT_EQ(asked, (std::vector<int>{15, 31}));  // 1.5 s after the first refusal, then 1.5 s after the next one
+}
+
+TEST(VisualWatch, AnAcceptedOrAbsentVisBetweenRefusalsStartsTheCountAgainAndZeroNeverAsks) {
+  VisualWatch watch(1.5);
+  const std::string why = "the VIS's velocity differs from the IMU's prediction by 1.20 m/s";
+  for (int k = 0; k < 100; ++k) {
+    const bool used = k % 10 == 9;     // accepted once a second
+    const bool absent = k % 10 == 4;   // no usable state (a blackout, the warm-up) half-way
+    EXPECT_TRUE(watch.onSweep(k * kSec / 10, used, used || absent ? std::string() : why).empty()) << k;
+  }
+  VisualWatch never(0.0);
+  for (int k = 0; k < 100; ++k) EXPECT_TRUE(never.onSweep(k * kSec / 10, false, why).empty()) << k;
+}
+
 }  // namespace
 
 TEST(VisualMotion, TheIncrementBetweenTwoSweepStampsIsTheTrueMotionCarriedFromTheFramesBeforeThem) {
@@ -184,6 +212,11 @@ TEST(VisualMotion, InvalidSettingsAreRefusedNamingTheKey) {
   c = {};
   c.max_age = std::nan("");
   EXPECT_NE(c.validate().find("max_age"), std::string::npos);
+  c = {};
+  c.reset_after = -1;
+  EXPECT_NE(c.validate().find("reset_after"), std::string::npos);
+  c = {};
+  c.max_age = std::nan("");
   EXPECT_THROW(VisualMotion(c, imu::PreintegrationConfig{}), std::invalid_argument);
   EXPECT_TRUE(VisualMotionConfig{}.validate().empty());
 }

@@ -21,12 +21,19 @@ struct LiveCourse {
   Trajectory truth;  // T_world_imu at 200 Hz, on the IMU's and the sweeps' stamps
 };
 
-inline LiveCourse simulateLiveCourse(const std::string& name, double duration_s, unsigned seed, bool camera = false) {
+// faults: windows relative to the scenario's start (as drover sim --fault).
+inline LiveCourse simulateLiveCourse(const std::string& name, double duration_s, unsigned seed, bool camera = false,
+                                     std::vector<sim::SensorFault> faults = {}) {
   sim::ScenarioOptions so;
   so.duration_s = duration_s;
   const sim::Scenario scenario = sim::makeScenario(name, so);
   sim::SimulatorConfig config = sim::SimulatorConfig::defaults();
   config.enable_camera = camera;
+  for (sim::SensorFault& f : faults) {
+    f.start += scenario.trajectory->startTime();
+    f.end += scenario.trajectory->startTime();
+  }
+  config.faults = std::move(faults);
   const sim::Simulator simulator(scenario, config, seed);
   LiveCourse c;
   simulator.run([&](Measurement&& m) { c.stream.push_back(std::move(m)); });

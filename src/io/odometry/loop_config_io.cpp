@@ -10,6 +10,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
   s.bind("enabled", c.enabled)
       .bindChoice("source", e.source, {"scancontext", "radius", "both"})
       .bind("yaw_prior", c.yaw_prior)
+      .bind("visual_yaw_prior", c.visual_yaw_prior)
       .bindChoice("shift_fallback", e.shift_fallback, {"always", "budget", "never"})
       .bindSeconds("min_age", c.min_age, atLeast(0, "s"))
       .bind("submap_keyframes", c.submap_keyframes)

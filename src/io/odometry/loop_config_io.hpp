@@ -1,7 +1,7 @@
 #pragma once
 // The `loop:` section of a platform config -> pipeline::LoopClosureConfig (read by loadOdometryConfig). Keys, all
 // optional (left out = the defaults in pipeline/loop_closure.hpp and loop/*.hpp, which give the units):
-//   loop: enabled, source (scancontext | radius | both), yaw_prior, shift_fallback (always | budget | never),
+//   loop: enabled, source (scancontext | radius | both), yaw_prior, visual_yaw_prior, shift_fallback (always | budget | never),
 //         min_age [s], submap_keyframes,
 //         max_verifications, skip_after_loop, radius [m], odometry_sigma_position [m], odometry_sigma_rotation [rad],
 //         degenerate_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m],

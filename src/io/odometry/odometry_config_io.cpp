@@ -121,7 +121,8 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bindSeconds("max_keyframe_gap", c.max_keyframe_gap, atLeast(0, "s"))
       .bind("standing_speed", c.standing_speed)
       .bind("max_velocity_difference", c.max_velocity_difference)
-      .bind("max_position_difference", c.max_position_difference);
+      .bind("max_position_difference", c.max_position_difference)
+      .bindSeconds("reset_after", c.reset_after, atLeast(0, "s"));
 }
 
 // The binder has already checked the values (bindChoice), with their lines.

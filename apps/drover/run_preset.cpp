@@ -1,0 +1,117 @@
+#include "apps/drover/run_preset.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+namespace drover::cli {
+
+std::vector<std::string> presetNames() { return {"drover", "lvi-sam"}; }
+
+Preset presetFromName(const std::string& name) {
+  if (name.empty()) return Preset::kPlatform;
+  if (name == "drover") return Preset::kDrover;
+  if (name == "lvi-sam") return Preset::kLviSam;
+  throw std::invalid_argument("--preset: unknown preset '" + name + "' (expected drover or lvi-sam)");
+}
+
+const char* presetName(Preset preset) {
+  switch (preset) {
+    case Preset::kDrover: return "drover";
+    case Preset::kLviSam: return "lvi-sam";
+    case Preset::kPlatform: break;
+  }
+  return "platform";
+}
+
+namespace {
+
+// LVI-SAM's updateInitialGuess takes the VINS odometry whenever its reset ID matches: no gates, no reset.
+void withoutGates(pipeline::VisualMotionConfig& f) {
+  constexpr double kNever = std::numeric_limits<double>::max();
+  f.max_keyframe_gap = f.max_velocity_difference = f.max_position_difference = kNever;
+  f.reset_after = 0;
+  f.min_features = 1;
+}
+
+}  // namespace
+
+void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
+  pipeline::VisualMotionConfig& f = odometry.vis_fusion;
+  pipeline::LoopClosureConfig& loop = odometry.loop;
+  if (preset == Preset::kDrover) {
+    f.factor = f.initial_guess = true;
+    f.reset_after = pipeline::VisualMotionConfig{}.reset_after;
+    loop.source = pipeline::LoopSource::kScanContext;
+    loop.yaw_prior = loop.visual_yaw_prior = true;
+  } else if (preset == Preset::kLviSam) {
+    f.factor = false;
+    f.initial_guess = true;
+    withoutGates(f);
+    // LIO-SAM / LVI-SAM params_lidar.yaml: historyKeyframeSearchRadius 15 m, historyKeyframeSearchTimeDiff 30 s,
+    // keyframes every 1 m or 0.2 rad.
+    loop.source = pipeline::LoopSource::kRadius;
+    loop.radius = 15.0;
+    loop.min_age = 30.0;
+    loop.yaw_prior = loop.visual_yaw_prior = false;
+    odometry.keyframes.distance = 1.0;
+    odometry.keyframes.angle = 0.2;
+  }
+}
+
+void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
+  if (preset == Preset::kDrover) {
+    visual.detector.type = visual::DetectorType::kSuperPoint;
+    vio.depth_mode = vio::DepthMode::kFactor;
+  } else if (preset == Preset::kLviSam) {
+    // LVI-SAM params_camera.yaml: max_cnt 150, min_dist 20, F_threshold 1.0, keyframe_parallax 10, window 10.
+    visual.detector.type = visual::DetectorType::kShiTomasi;
+    visual.tracker.max_features = 150;
+    visual.tracker.min_distance = 20;
+    visual.tracker.ransac_threshold_px = 1.0;
+    vio.min_parallax_px = 10;
+    vio.window = 10;
+    vio.depth_mode = vio::DepthMode::kFixed;
+  }
+}
+
+std::vector<std::string> partNames() {
+  return {"vo-factor", "vis-guess", "vis-gates", "visual-yaw-prior", "scan-context", "depth-factor", "superpoint"};
+}
+
+void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
+  const std::vector<std::string> names = partNames();
+  if (std::find(names.begin(), names.end(), part) == names.end())
+    throw std::invalid_argument("--without: unknown part '" + part + "'");
+  if (part == "vo-factor") odometry.vis_fusion.factor = false;
+  if (part == "vis-guess") odometry.vis_fusion.initial_guess = false;
+  if (part == "vis-gates") withoutGates(odometry.vis_fusion);
+  if (part == "visual-yaw-prior") odometry.loop.visual_yaw_prior = false;
+  if (part == "scan-context") {
+    odometry.loop.source = pipeline::LoopSource::kRadius;
+    odometry.loop.radius = 15.0;
+  }
+}
+
+void removePart(const std::string& part, io::VisualConfig& visual, vio::VioConfig& vio) {
+  if (part == "depth-factor") vio.depth_mode = vio::DepthMode::kFixed;
+  if (part == "superpoint") visual.detector.type = visual::DetectorType::kShiTomasi;
+}
+
+std::string MethodChoice::describe() const {
+  std::string s = presetName(preset);
+  for (std::size_t i = 0; i < without.size(); ++i) s += (i == 0 ? " without " : ", ") + without[i];
+  return s;
+}
+
+void MethodChoice::apply(pipeline::OdometryConfig& odometry) const {
+  applyPreset(preset, odometry);
+  for (const std::string& part : without) removePart(part, odometry);
+}
+
+void MethodChoice::apply(io::VisualConfig& visual, vio::VioConfig& vio) const {
+  applyPreset(preset, visual, vio);
+  for (const std::string& part : without) removePart(part, visual, vio);
+}
+
+}  // namespace drover::cli
