@@ -42,7 +42,7 @@ for c in "${COURSES[@]}"; do
   data="$OUT_ROOT/sim/$c-cam"
   [ -f "$data/scenario.json" ] ||
     "$DROVER" sim --scenario "$scenario" --seed "$seed" --config "$CONFIG" --out "$data" --force -q
-  mkdir -p "bench/out/ablation/$c"
+  mkdir -p "bench/out/ablation/$c" "$OUT_ROOT/ablation/$c"
   for row in "${ROWS[@]}"; do
     run="$OUT_ROOT/ablation/$c/$row"
     read -r -a flags <<< "$(row_flags "$row")"

@@ -40,6 +40,7 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
   pipeline::VisualMotionConfig& f = odometry.vis_fusion;
   pipeline::LoopClosureConfig& loop = odometry.loop;
   if (preset == Preset::kDrover) {
+    odometry.degenerate_pose_from_match = false;
     f.factor = f.initial_guess = true;
     f.reset_after = pipeline::VisualMotionConfig{}.reset_after;
     loop.source = pipeline::LoopSource::kScanContext;
@@ -56,6 +57,8 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
     loop.yaw_prior = loop.visual_yaw_prior = false;
     odometry.keyframes.distance = 1.0;
     odometry.keyframes.angle = 0.2;
+    // mapOptimization's pose is the scan match, its degenerate directions kept at the (VIS) guess.
+    odometry.degenerate_pose_from_match = true;
   }
 }
 

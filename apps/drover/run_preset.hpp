@@ -6,7 +6,8 @@
 //   lvi-sam: LVI-SAM as released (Shan et al., ICRA 2021; github.com/TixiaoShan/LVI-SAM): Shi-Tomasi + KLT (VINS-Mono
 //            max_cnt 150, min_dist 20, F_threshold 1), lidar depth held fixed, the VIS's motion as the scan
 //            matcher's guess whenever the VIS has an estimate (no visual odometry factor: LVI-SAM issue #7; none of
-//            Drover's health gates, no reset of the VIS by the LIS), loop closure by the nearest old keyframe within
+//            Drover's health gates, no reset of the VIS by the LIS), a degenerate match's pose the match's own (its
+//            degenerate directions at the guess, as LIO-SAM's mapOptimization), loop closure by the nearest old keyframe within
 //            15 m and 30 s verified by ICP (no Scan Context). Its visual DBoW2 loop detector is not reproduced.
 //   drover:  SuperPoint + KLT, lidar depth as factors, the VIS's motion as guess and factor behind the health gates
 //            with resets by the LIS, Scan Context with the VIS's yaw prior.

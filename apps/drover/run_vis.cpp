@@ -157,11 +157,12 @@ Json RunVis::report() const {
   for (const Event& e : events_) events.push_back({{"t", toSeconds(e.t)}, {"kind", e.kind}, {"what", e.what}});
   j["events"] = events;
   // Means over the frames, and per frame (compact columns).
-  double track = 0, depth = 0, solve = 0, marg = 0, total = 0, tracked = 0, with_depth = 0, three = 0;
+  double track = 0, depth = 0, solve = 0, marg = 0, cov = 0, total = 0, tracked = 0, with_depth = 0, three = 0;
   std::size_t n = 0, keyframes = 0, detected = 0;
   Json frames = Json::array();
   for (const VisFrameRecord& r : records_) {
     track += r.ms.track, depth += r.ms.depth, solve += r.ms.solve, marg += r.ms.marginalize, total += r.ms.total;
+    cov += r.ms.covariance;
     tracked += r.tracked, with_depth += r.with_depth, three += r.share_three;
     keyframes += r.keyframe ? 1 : 0;
     detected += r.detected ? 1 : 0;
@@ -176,7 +177,7 @@ Json RunVis::report() const {
                {"features_with_lidar_depth", with_depth / d},
                {"share_features_in_3_or_more_frames", three / d}};
   j["ms_per_frame"] = {{"track", track / d}, {"depth", depth / d}, {"solve", solve / d},
-                       {"marginalize", marg / d}, {"total", total / d}};
+                       {"marginalize", marg / d}, {"covariance", cov / d}, {"total", total / d}};
   j["frame_columns"] = {"t", "initialized", "tracked", "features", "with_lidar_depth", "keyframe", "outliers", "ms"};
   j["frames"] = frames;
   return j;

@@ -192,7 +192,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   out.gyro_bias = r.bias.gyro;
   out.acc_bias = r.bias.acc;
   const Eigen::Isometry3d T_world_lidar_fused = r.state.T_world_imu * T_imu_lidar_;
-  if (out.degenerate || !out.match_usable) {
+  if (!out.match_usable || (out.degenerate && !config_.degenerate_pose_from_match)) {
     // The lidar left some directions (or all) to the IMU: the fused state is the pose.
     out.T_world_lidar = T_world_lidar_fused;
   } else if (config_.gravity_roll_pitch) {

@@ -35,6 +35,10 @@ struct OdometryConfig {
   // keep the lidar's heading and position. Scan matching alone lets tilt drift (1.5 deg over the simulated garage
   // exit, 0.01 deg with this); LIO-SAM blends the IMU's roll/pitch in with imuRPYWeight for the same reason.
   bool gravity_roll_pitch = true;
+  // A degenerate match's pose: false (Drover) the smoother's fused state, which carries the degenerate directions by
+  // the IMU and the VIS's motion factor; true (LIO-SAM / LVI-SAM) the scan match's own, whose degenerate directions
+  // Zhang's remapping keeps at the initial guess (LVI-SAM's VIS motion when it is the guess).
+  bool degenerate_pose_from_match = false;
   // Without an IMU the sweep is deskewed with the constant-velocity motion of the previous sweeps; that closes a
   // feedback loop (a pose error skews the next deskew, which skews the next pose) that can oscillate. After the
   // match the sweep is deskewed again with its own estimated motion and re-matched, this many times (LOAM iterates

@@ -16,7 +16,9 @@ std::string VisualMotionConfig::validate() const {
                                 {"max_age", max_age},
                                 {"max_keyframe_gap", max_keyframe_gap},
                                 {"max_velocity_difference", max_velocity_difference},
-                                {"max_position_difference", max_position_difference}})
+                                {"max_position_difference", max_position_difference},
+                                {"window_floor_position", window_floor_position},
+                                {"window_floor_rotation", window_floor_rotation}})
     if (!std::isfinite(v) || v <= 0) return fmt::format("{} must be finite and > 0, got {}", name, v);
   for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position_ratio", sigma_position_ratio},
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
@@ -41,7 +43,8 @@ std::optional<VisualState> VisualStateStream::onFrame(const vio::FrameResult& r)
     keyframe_time_ = r.t;
   }
   return VisualState{r.t,         r.T_world_imu, r.v_world,      r.bias,           r.features,
-                     init_count_, init_time_,    keyframe_time_, keyframe_interval_};
+                     init_count_, init_time_,    keyframe_time_, keyframe_interval_,
+                     r.just_initialized ? std::nullopt : r.relative_covariance};
 }
 
 VisualMotion::VisualMotion(const VisualMotionConfig& config, const imu::PreintegrationConfig& imu)
@@ -90,6 +93,28 @@ std::optional<imu::NavState> VisualMotion::stateAt(Time t, const imu::ImuPropaga
   return pim.predict(imu::NavState{s.t, s.T_world_imu, s.v_world}, s.bias);
 }
 
+// The frames' relative covariances are each in their previous frame's IMU frame; summed as independent steps after
+// rotating each into a's frame (the steps' own rotations are small between two sweeps).
+std::optional<Eigen::Matrix<double, 6, 6>> VisualMotion::windowCovariance(const VisualState* a,
+                                                                          const VisualState* b) const {
+  Eigen::Matrix<double, 6, 6> sum = Eigen::Matrix<double, 6, 6>::Zero();
+  sum.diagonal() << Eigen::Vector3d::Constant(config_.window_floor_position * config_.window_floor_position),
+      Eigen::Vector3d::Constant(config_.window_floor_rotation * config_.window_floor_rotation);
+  const Eigen::Matrix3d R_world_a = a->T_world_imu.linear();
+  auto it = std::upper_bound(states_.begin(), states_.end(), a->t,
+                             [](Time x, const VisualState& s) { return x < s.t; });
+  const VisualState* previous = a;
+  for (; it != states_.end() && it->t <= b->t; ++it) {
+    if (!it->relative_covariance) return std::nullopt;
+    Eigen::Matrix<double, 6, 6> G = Eigen::Matrix<double, 6, 6>::Zero();
+    const Eigen::Matrix3d R_a_prev = R_world_a.transpose() * previous->T_world_imu.linear();
+    G.topLeftCorner<3, 3>() = G.bottomRightCorner<3, 3>() = R_a_prev;
+    sum += G * *it->relative_covariance * G.transpose();
+    previous = &*it;
+  }
+  return sum;
+}
+
 std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu::ImuPropagator& imu,
                                                        std::string* why) const {
   std::string reason;
@@ -113,6 +138,15 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   inc.v_b = xb->T_world_imu.linear().transpose() * xb->v_world;
   inc.last_keyframe_at = sb->last_keyframe_at;
   inc.keyframe_interval = sb->keyframe_interval;
+  inc.sqrt_information.setZero();
+  if (config_.window_covariance) {
+    if (const std::optional<Eigen::Matrix<double, 6, 6>> cov = windowCovariance(sa, sb)) {
+      const Eigen::Matrix<double, 6, 6> information = cov->inverse();
+      inc.sqrt_information = Eigen::LLT<Eigen::Matrix<double, 6, 6>>(0.5 * (information + information.transpose()))
+                                 .matrixU();
+      if (inc.sqrt_information.allFinite()) return inc;
+    }
+  }
   // Fewer features than a full frame: the sigmas grow as 1/sqrt(n), as a mean over n independent features would.
   const int n = std::min(sa->features, sb->features);
   const double scale = std::sqrt(static_cast<double>(config_.full_features) / std::min(n, config_.full_features));
@@ -120,7 +154,6 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   const double turned = geometry::logSO3(inc.T_a_b.linear()).norm();
   const double sp = scale * (config_.sigma_position + config_.sigma_position_ratio * moved);
   const double sr = scale * (config_.sigma_rotation + config_.sigma_rotation_ratio * turned);
-  inc.sqrt_information.setZero();
   inc.sqrt_information.diagonal() << Eigen::Vector3d::Constant(1 / sp), Eigen::Vector3d::Constant(1 / sr);
   return inc;
 }

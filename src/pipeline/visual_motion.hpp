@@ -30,6 +30,12 @@ struct VisualMotionConfig {
   double sigma_position_ratio = 0.05;  // [m per m moved]
   double sigma_rotation = 0.01;        // [rad]
   double sigma_rotation_ratio = 0.05;  // [rad per rad turned]
+  // Instead of the sigmas above: the VIS window's own covariance of its motion (the per-frame relative-pose
+  // covariances of vio.relative_covariance, summed over the frames between the two states) plus these floors for
+  // what the window's linearisation leaves out (the IMU carry from the frames to the sweep stamps).
+  bool window_covariance = false;
+  double window_floor_position = 0.005;  // [m]
+  double window_floor_rotation = 0.002;  // [rad]
   int min_features = 20;    // [-] a VIS state with fewer features in its solve is not used
   int full_features = 80;   // [-] below this many the sigmas grow as sqrt(full_features / features)
   double warmup = 1.0;      // [s] after the VIS (re)initialises its states are not used for this long
@@ -64,6 +70,8 @@ struct VisualState {
   Time initialized_at = 0;    // [ns] when the VIS last (re)initialised
   Time last_keyframe_at = 0;  // [ns] the VIS's newest keyframe (its initialisation when none since)
   Time keyframe_interval = 0; // [ns] from the keyframe before it (0 when none)
+  // Of the pose relative to the previous frame's state (vio::FrameResult::relative_covariance), when computed.
+  std::optional<Eigen::Matrix<double, 6, 6>> relative_covariance;
 };
 
 // The VIS's per-frame results as VisualStates, its (re)initialisations numbered (LVI-SAM's reset ID). Shared by
@@ -113,6 +121,8 @@ class VisualMotion {
   // The VIS's state at t: the newest usable state at or before t, propagated to t.
   std::optional<imu::NavState> stateAt(Time t, const imu::ImuPropagator& imu, const VisualState** used,
                                       std::string* why) const;
+  // The window's covariance of the motion from state a to state b (nothing when a state between lacks one).
+  std::optional<Eigen::Matrix<double, 6, 6>> windowCovariance(const VisualState* a, const VisualState* b) const;
   VisualMotionConfig config_;
   imu::PreintegrationConfig imu_;
   std::deque<VisualState> states_;

@@ -164,6 +164,12 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
     return result;
   }
   fillResult(result);
+  if (config_.relative_covariance) {
+    const auto start = std::chrono::steady_clock::now();
+    result.relative_covariance = newestRelativeCovariance();
+    result.ms_covariance =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
   last_output_ = result;
   if (static_cast<int>(frames_.size()) > config_.window) slide(keyframe, result);
   return result;

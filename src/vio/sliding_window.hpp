@@ -52,11 +52,14 @@ struct FrameResult {
   int with_lidar_depth = 0;         // of those, anchored on a lidar depth
   int outliers = 0;                 // observations dropped after the solve
   int iterations = 0;
-  double ms_solve = 0, ms_marginalize = 0;  // [ms]
+  double ms_solve = 0, ms_marginalize = 0, ms_covariance = 0;  // [ms]
   Eigen::Isometry3d T_world_imu = Eigen::Isometry3d::Identity();
   Eigen::Vector3d v_world = Eigen::Vector3d::Zero();
   imu::ImuBias bias;
   double td = 0;                    // [s] estimated time offset on top of the calibration's
+  // The covariance of this frame's pose relative to the previous frame's, [dp in the previous frame's IMU frame (m);
+  // dtheta (rad)], from the window's information with everything else marginalised (vio.relative_covariance).
+  std::optional<Eigen::Matrix<double, 6, 6>> relative_covariance;
 };
 
 class SlidingWindowEstimator {
@@ -104,6 +107,7 @@ class SlidingWindowEstimator {
   void marginalizeSecondNewest();
   void fixGauge(const Eigen::Isometry3d& T_world_imu0_before);
   void fillResult(FrameResult& result) const;
+  std::optional<Eigen::Matrix<double, 6, 6>> newestRelativeCovariance();  // window_covariance.cpp
 
   VioConfig config_;
   imu::PreintegrationConfig imu_config_;

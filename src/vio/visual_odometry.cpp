@@ -68,6 +68,7 @@ VisFrame VisualOdometry::addFrame(const CameraFrame& frame, const PoseAt& lis_po
   out.estimate = estimator_.addFrame(t, features, seed);
   out.ms.solve = out.estimate.ms_solve;
   out.ms.marginalize = out.estimate.ms_marginalize;
+  out.ms.covariance = out.estimate.ms_covariance;
   out.share_three = estimator_.featuresInThreeOrMore();
   out.ms.total = msSince(t0);
   return out;

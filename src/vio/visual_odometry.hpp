@@ -27,7 +27,7 @@ struct VisConfig {
 };
 
 struct VisStageMs {  // [ms] wall time per stage of one frame
-  double track = 0, depth = 0, solve = 0, marginalize = 0, total = 0;
+  double track = 0, depth = 0, solve = 0, marginalize = 0, covariance = 0, total = 0;
 };
 
 struct VisFrame {

@@ -55,7 +55,8 @@ struct Course {
   }
   VisualState state(Time t, int features = 120, std::uint32_t reset_id = 1, Time initialized_at = 0) const {
     const sim::BodyState b = path.at(t);
-    return VisualState{t, b.T_world_body, b.v_world, imu::ImuBias{}, features, reset_id, initialized_at, t};
+    return VisualState{t, b.T_world_body, b.v_world, imu::ImuBias{}, features, reset_id, initialized_at, t, 0,
+                       std::nullopt};
   }
 };
 
@@ -120,6 +121,40 @@ TEST(VisualMotion, TheIncrementBetweenTwoSweepStampsIsTheTrueMotionCarriedFromTh
   EXPECT_NEAR(1 / inc->sqrt_information(0, 0), c.sigma_position + c.sigma_position_ratio * truth.translation().norm(),
               1e-5);
   EXPECT_NEAR(1 / inc->sqrt_information(4, 4), c.sigma_rotation + c.sigma_rotation_ratio * turned, 1e-6);
+}
+
+TEST(VisualMotion, WithTheWindowCovarianceTheSigmaIsTheFramesCovariancesSummedPlusTheFloor) {
+  VisualMotionConfig c;
+  c.window_covariance = true;
+  VisualMotion m(c, course().preintegration);
+  // Each frame's motion from the one before: 3 mm and 1 mrad per axis (the VIS's window, vio::FrameResult).
+  Eigen::Matrix<double, 6, 6> step = Eigen::Matrix<double, 6, 6>::Zero();
+  step.diagonal() << Eigen::Vector3d::Constant(9e-6), Eigen::Vector3d::Constant(1e-6);
+  for (Time t = 0; t <= 6 * kSec; t += kFrame) {
+    VisualState s = course().state(t);
+    if (t > 0) s.relative_covariance = step;
+    m.add(s);
+  }
+  const Time a = 5 * kSec + 30'000'000, b = a + kSec / 10;  // states at 5.000 and 5.067 s (frames 75, 76): one step
+  std::string why;
+  const std::optional<VisualIncrement> inc = m.increment(a, b, course().propagator(6 * kSec), &why);
+  ASSERT_TRUE(inc) << why;
+  const Eigen::Matrix<double, 6, 6> cov = (inc->sqrt_information.transpose() * inc->sqrt_information).inverse();
+  // Rotated into a's frame per step; the traces do not depend on that rotation.
+  const double position_trace = cov.topLeftCorner(3, 3).trace(), rotation_trace = cov.bottomRightCorner(3, 3).trace();
+  EXPECT_NEAR(position_trace, 3 * (9e-6 + c.window_floor_position * c.window_floor_position), 1e-9);
+  EXPECT_NEAR(rotation_trace, 3 * (1e-6 + c.window_floor_rotation * c.window_floor_rotation), 1e-10);
+  // A frame without a covariance between: the drift model instead.
+  VisualMotion gap(c, course().preintegration);
+  for (Time t = 0; t <= 6 * kSec; t += kFrame) {
+    VisualState s = course().state(t);
+    if (t > 0 && t != 76 * kFrame) s.relative_covariance = step;  // the frame at 5.067 s has none
+    gap.add(s);
+  }
+  const std::optional<VisualIncrement> drift = gap.increment(a, b, course().propagator(6 * kSec), &why);
+  ASSERT_TRUE(drift) << why;
+  EXPECT_NEAR(1 / drift->sqrt_information(5, 5), c.sigma_rotation + c.sigma_rotation_ratio *
+              geometry::logSO3(drift->T_a_b.linear()).norm(), 1e-6);
 }
 
 TEST(VisualMotion, FewerFeaturesThanAFullFrameWidenTheSigmasAsOneOverTheSquareRoot) {

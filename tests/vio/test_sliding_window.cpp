@@ -2,7 +2,12 @@
 // trajectory, finds the IMU biases and the camera time offset, and keeps doing so across marginalisations.
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
 #include <optional>
+#include <utility>
 
 #include "vio/window_run.hpp"
 
@@ -49,6 +54,46 @@ TEST(SlidingWindow, SeededFromTruthTracksTwelveSecondsWithinTwoCentimetresAndFin
   EXPECT_LT((last.bias.gyro - scene.gyro_bias).norm(), 1e-3);
   EXPECT_LT((last.bias.acc - scene.acc_bias).norm(), 0.05);
   EXPECT_LT((last.v_world - scene.truth(toSeconds(last.t)).v_world).norm(), 0.05);
+}
+
+// The window's covariance of the newest frame's motion (what the LIS weights the VIS's motion by): positive
+// definite, millimetres over one frame with 80 features, and wider when the frames see 12 features instead.
+TEST(SlidingWindow, TheNewestFramesRelativeCovarianceIsPositiveAndWiderWithFewerFeatures) {
+  const WindowScene scene;
+  const auto meanSigma = [&scene](int keep) {
+    SlidingWindowEstimator est(config(), imuConfig(), scene.T_imu_cam, 460);
+    WindowRun run{scene};
+    run.edit = [keep](double, std::vector<FrameFeature>& f) {
+      if (static_cast<int>(f.size()) > keep) f.resize(static_cast<std::size_t>(keep));
+    };
+    const Seeder seed = truthSeeder(scene);
+    double position = 0, rotation = 0;
+    int n = 0;
+    for (double t = 0.05; t < 6; t += 1.0 / run.camera_hz) {
+      const FrameResult r = run.frame(est, t, seed);
+      EXPECT_FALSE(r.reset) << r.event;
+      if (!r.initialized || r.just_initialized || t < 3) continue;
+      EXPECT_TRUE(r.relative_covariance.has_value()) << "t " << t;
+      if (!r.relative_covariance) continue;
+      const Eigen::Matrix<double, 6, 6>& c = *r.relative_covariance;
+      const bool positive = Eigen::LLT<Eigen::Matrix<double, 6, 6>>(c).info() == Eigen::Success;
+      EXPECT_TRUE(positive) << "t " << t;
+      EXPECT_LT((c - c.transpose()).cwiseAbs().maxCoeff(), 1e-12 * c.cwiseAbs().maxCoeff());
+      position += std::sqrt(c.topLeftCorner<3, 3>().trace() / 3);
+      rotation += std::sqrt(c.bottomRightCorner<3, 3>().trace() / 3);
+      ++n;
+    }
+    EXPECT_GT(n, 30);
+    return std::pair<double, double>{position / std::max(n, 1), rotation / std::max(n, 1)};
+  };
+  const auto [p80, r80] = meanSigma(80);
+  const auto [p12, r12] = meanSigma(12);
+  std::printf("relative sigma per frame: 80 features %.2e m %.2e rad; 12 features %.2e m %.2e rad\n", p80, r80, p12,
+              r12);
+  EXPECT_GT(p80, 1e-5);
+  EXPECT_LT(p80, 0.01);
+  EXPECT_GT(p12, 1.3 * p80);
+  EXPECT_GT(r12, 1.3 * r80);
 }
 
 TEST(SlidingWindow, KeepsTheWindowAtItsSizeAndSaysWhyItWaitsBeforeInitialisation) {

@@ -5,6 +5,7 @@
 //   odometry: use_imu, deskew, min_points, imu_wait [s], lidar_sigma_position [m], lidar_sigma_rotation [rad],
 //             degenerate_sigma, use_imu_orientation (take a 9-axis unit's orientation at initialisation; false
 //             when it is not of the IMU's acc/gyro frame, as LIO-SAM's extrinsicRPY != extrinsicRot says)
+//             degenerate_pose_from_match (a degenerate match keeps its own pose, as LIO-SAM; default: the smoother's)
 //     layout:       n_rings, vertical_fov_min_deg, vertical_fov_max_deg, columns, scan_period [s],
 //                   spin (ccw | cw), ring_source (elevation | order), order_top_down, min_range, max_range [m]
 //     features:     edge_threshold, surf_threshold (LIO-SAM edgeThreshold/surfThreshold), surf_leaf, edge_leaf,
@@ -16,7 +17,8 @@
 //     imu:          gyro_noise_density, acc_noise_density, gyro_bias_random_walk, acc_bias_random_walk, gravity
 //     smoother:     window, max_iterations, ...
 //     vis_fusion:   factor, initial_guess (the VIS's motion in the LIS, while a VIS runs), sigma_position [m],
-//                   sigma_position_ratio [m/m], sigma_rotation [rad], sigma_rotation_ratio [rad/rad], min_features,
+//                   sigma_position_ratio [m/m], sigma_rotation [rad], sigma_rotation_ratio [rad/rad],
+//                   window_covariance (bool), window_floor_position [m], window_floor_rotation [rad], min_features,
 //                   full_features, warmup [s], max_age [s], max_keyframe_gap [s], standing_speed [m/s],
 //                   max_velocity_difference [m/s],
 //                   max_position_difference [m], reset_after [s] (pipeline/visual_motion.hpp)

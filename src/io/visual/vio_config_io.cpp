@@ -45,6 +45,7 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
       .bind("max_solver_ms", c.max_solver_ms)
       .bind("estimate_extrinsic", c.estimate_extrinsic)
       .bind("estimate_time_offset", c.estimate_time_offset)
+      .bind("relative_covariance", c.relative_covariance)
       .bindSeconds("max_time_offset_s", c.max_time_offset_s, positive("s"))
       .bindSeconds("time_offset_sigma_s", c.time_offset_sigma_s, positive("s"))
       .bind("imu_midpoint", c.imu_midpoint)

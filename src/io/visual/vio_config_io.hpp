@@ -5,7 +5,7 @@
 //   vio: window, min_parallax_px [px], min_tracked_for_parallax, focal_px [px], sigma_px [px], robust_px [px],
 //        outlier_px [px], min_observations, max_features, depth_mode (fixed | factor | off), depth_sigma_m [m],
 //        depth_sigma_rel, depth_sigma_spread, max_iterations, max_solver_ms [ms], estimate_extrinsic (bool),
-//        estimate_time_offset (bool), time_offset_sigma_s [s], max_time_offset_s [s], imu_midpoint (bool),
+//        estimate_time_offset (bool), relative_covariance (bool), time_offset_sigma_s [s], max_time_offset_s [s], imu_midpoint (bool),
 //        init (auto | lis | visual), init_min_parallax_px [px],
 //        init_sigma_position_m [m], lis_sigma_rotation_rad / align_sigma_rotation_rad [rad],
 //        lis_sigma_velocity / align_sigma_velocity [m/s], lis_sigma_gyro_bias / align_sigma_gyro_bias [rad/s],
