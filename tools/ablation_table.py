@@ -66,6 +66,7 @@ def main():
     ap.add_argument("out")
     ap.add_argument("--runs", default=os.path.join(os.environ.get("DROVER_OUT", "out"), "ablation"))
     a = ap.parse_args()
+    os.makedirs(a.out, exist_ok=True)
     lines = []
     for course_dir in sorted(glob.glob(os.path.join(a.results, "*"))):
         course = os.path.basename(course_dir)
@@ -109,7 +110,6 @@ def main():
             fig.savefig(path, dpi=110)
             lines.append(f"![APE over time, {course}](ablation_ape_{course}.png)")
             lines.append("")
-    os.makedirs(a.out, exist_ok=True)
     with open(os.path.join(a.out, "ablation.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))

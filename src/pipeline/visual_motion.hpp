@@ -32,7 +32,9 @@ struct VisualMotionConfig {
   double sigma_rotation_ratio = 0.05;  // [rad per rad turned]
   // Instead of the sigmas above: the VIS window's own covariance of its motion (the per-frame relative-pose
   // covariances of vio.relative_covariance, summed over the frames between the two states) plus these floors for
-  // what the window's linearisation leaves out (the IMU carry from the frames to the sweep stamps).
+  // what the window's linearisation leaves out (the IMU carry from the frames to the sweep stamps). Needs
+  // vio.relative_covariance: without it the drift model above is used. Farm course, no loops: 0.23 % against 0.28 %
+  // with the drift model, the difference within reruns; corridor 0.30 % against 0.41-0.60 %.
   bool window_covariance = false;
   double window_floor_position = 0.005;  // [m]
   double window_floor_rotation = 0.002;  // [rad]

@@ -61,7 +61,9 @@ TEST(SlidingWindow, SeededFromTruthTracksTwelveSecondsWithinTwoCentimetresAndFin
 TEST(SlidingWindow, TheNewestFramesRelativeCovarianceIsPositiveAndWiderWithFewerFeatures) {
   const WindowScene scene;
   const auto meanSigma = [&scene](int keep) {
-    SlidingWindowEstimator est(config(), imuConfig(), scene.T_imu_cam, 460);
+    VioConfig c = config();
+    c.relative_covariance = true;
+    SlidingWindowEstimator est(c, imuConfig(), scene.T_imu_cam, 460);
     WindowRun run{scene};
     run.edit = [keep](double, std::vector<FrameFeature>& f) {
       if (static_cast<int>(f.size()) > keep) f.resize(static_cast<std::size_t>(keep));
