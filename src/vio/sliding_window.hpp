@@ -23,6 +23,10 @@
 #include "vio/feature_manager.hpp"
 #include "vio/vio_config.hpp"
 
+namespace ceres {
+class CostFunction;
+}
+
 namespace drover::backend {
 class MarginalPriorFactor;
 class SchurMarginalizer;
@@ -103,6 +107,13 @@ class SlidingWindowEstimator {
   std::string failure(const FrameResult& previous_output) const;
   void slide(bool keyframe, FrameResult& result);
   void declareWindowBlocks(backend::SchurMarginalizer& m);
+  // A held (depth_mode fixed) lidar depth as a tight inverse-depth factor, so that a Schur complement conditions on
+  // it rather than forgetting it (window_marginalize.cpp; the marginalisation and the relative covariance).
+  struct HeldDepth {
+    std::unique_ptr<ceres::CostFunction> factor;
+    double* inverse_depth = nullptr;
+  };
+  std::vector<HeldDepth> heldDepths(const Residuals& r);
   void marginalizeOldest();
   void marginalizeSecondNewest();
   void fixGauge(const Eigen::Isometry3d& T_world_imu0_before);

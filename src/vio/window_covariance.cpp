@@ -7,7 +7,6 @@
 
 #include "backend/pose_factors.hpp"
 #include "backend/schur_marginalizer.hpp"
-#include "backend/visual_factors.hpp"
 #include "geometry/so3.hpp"
 #include "vio/window_frame.hpp"
 #include "vio/window_residuals.hpp"
@@ -29,7 +28,6 @@ class ScalarPrior final : public ceres::SizedCostFunction<1, 1> {
   double x0_, weight_;
 };
 
-constexpr double kHeldDepthSigma = 1e-3;  // [m per m of depth] a held lidar depth is conditioned on (as marginalised)
 constexpr double kConstantSigma = 1e-6;   // [m, rad, s] an extrinsic or time offset the solve holds constant
 
 }  // namespace
@@ -41,12 +39,9 @@ std::optional<Eigen::Matrix<double, 6, 6>> SlidingWindowEstimator::newestRelativ
   Residuals r;
   buildResiduals(r, false);
   for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
+  const std::vector<HeldDepth> depths = heldDepths(r);
+  for (const HeldDepth& h : depths) m.addResidual(h.factor.get(), nullptr, {h.inverse_depth});
   std::vector<std::unique_ptr<ceres::CostFunction>> held;
-  for (auto& [id, f] : features_.features())
-    if (r.fixed_depths.count(&f.inverse_depth)) {
-      held.push_back(std::make_unique<backend::InverseDepthFactor>(f.depth, kHeldDepthSigma * f.depth));
-      m.addResidual(held.back().get(), nullptr, {&f.inverse_depth});
-    }
   if (!config_.estimate_extrinsic) {
     held.push_back(std::make_unique<backend::PosePriorFactor>(
         T_imu_cam(), backend::poseSqrtInformation(kConstantSigma, kConstantSigma)));

@@ -38,21 +38,25 @@ void SlidingWindowEstimator::declareWindowBlocks(backend::SchurMarginalizer& m) 
   m.addBlock(td_, 1, nullptr);
 }
 
+std::vector<SlidingWindowEstimator::HeldDepth> SlidingWindowEstimator::heldDepths(const Residuals& r) {
+  std::vector<HeldDepth> out;
+  for (auto& [id, f] : features_.features())
+    if (r.fixed_depths.count(&f.inverse_depth))
+      out.push_back({std::make_unique<backend::InverseDepthFactor>(f.depth, kHeldDepthSigma * f.depth),
+                     &f.inverse_depth});
+  return out;
+}
+
 void SlidingWindowEstimator::marginalizeOldest() {
   backend::SchurMarginalizer m;
   declareWindowBlocks(m);
   Residuals r;
   buildResiduals(r, true);
   for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
-  std::vector<std::unique_ptr<ceres::CostFunction>> held;
-  for (auto& [id, f] : features_.features())
-    if (r.fixed_depths.count(&f.inverse_depth))
-      held.push_back(std::make_unique<backend::InverseDepthFactor>(f.depth, kHeldDepthSigma * f.depth));
+  const std::vector<HeldDepth> held = heldDepths(r);
   if (prior_) m.addResidual(prior_.get(), nullptr, prior_->blocks());
   for (auto& item : r.items) m.addResidual(item.cost.get(), item.loss, item.blocks);
-  std::size_t h = 0;
-  for (auto& [id, f] : features_.features())
-    if (r.fixed_depths.count(&f.inverse_depth)) m.addResidual(held[h++].get(), nullptr, {&f.inverse_depth});
+  for (const HeldDepth& h : held) m.addResidual(h.factor.get(), nullptr, {h.inverse_depth});
   const Frame& oldest = *frames_.front();
   std::set<const double*> drop{oldest.p, oldest.q, oldest.v, oldest.bias};
   for (double* d : r.inverse_depths) drop.insert(d);
