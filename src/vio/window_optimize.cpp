@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <set>
 
 #include "backend/imu_factors.hpp"
 #include "backend/quaternion_manifold.hpp"
@@ -102,7 +103,7 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
   double* td = const_cast<double*>(td_);
   for (Feature* f : used) {
     f->inverse_depth = 1.0 / f->depth;
-    r.inverse_depths.insert(&f->inverse_depth);
+    r.inverse_depths.push_back(&f->inverse_depth);
     ++r.features;
     r.seen_three_times += f->obs.size() >= 3 ? 1 : 0;
     const Observation& oi = f->obs.front();
@@ -167,8 +168,8 @@ void SlidingWindowEstimator::optimize(FrameResult& result) {
   if (prior_) problem.AddResidualBlock(prior_.get(), nullptr, prior_->blocks());
   for (auto& item : r.items)
     problem.AddResidualBlock(item.cost.get(), const_cast<ceres::LossFunction*>(item.loss), item.blocks);
-  for (double* d : r.fixed_depths)
-    if (problem.HasParameterBlock(d)) problem.SetParameterBlockConstant(d);
+  for (double* d : r.inverse_depths)
+    if (r.fixed_depths.count(d) && problem.HasParameterBlock(d)) problem.SetParameterBlockConstant(d);
   if (!prior_ && !init_prior_.active) {  // no prior holds the gauge: hold the oldest pose
     problem.SetParameterBlockConstant(frames_.front()->p);
     problem.SetParameterBlockConstant(frames_.front()->q);
@@ -187,8 +188,9 @@ void SlidingWindowEstimator::optimize(FrameResult& result) {
   result.features = r.features;
   result.with_lidar_depth = r.with_lidar_depth;
 
+  const std::set<const double*> solved(r.inverse_depths.begin(), r.inverse_depths.end());
   for (auto& [id, f] : features_.features())
-    if (r.inverse_depths.count(&f.inverse_depth)) f.depth = f.inverse_depth > 0 ? 1.0 / f.inverse_depth : -1.0;
+    if (solved.count(&f.inverse_depth)) f.depth = f.inverse_depth > 0 ? 1.0 / f.inverse_depth : -1.0;
   fixGauge(T0_before);
   features_.removeFailures();
   share_three_ = r.features > 0 ? static_cast<double>(r.seen_three_times) / r.features : 0;

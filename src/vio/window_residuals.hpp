@@ -20,8 +20,11 @@ struct SlidingWindowEstimator::Residuals {
   };
   std::vector<Item> items;
   std::unique_ptr<ceres::LossFunction> robust;
-  std::set<double*> inverse_depths;     // every feature block used
-  std::set<double*> fixed_depths;       // depth_mode fixed: lidar-anchored features
+  // Every feature block used, in the order of the features (by id). The marginalisation declares its blocks in this
+  // order, so it must not follow their addresses: a std::set<double*> made the replay with a lidar run-to-run
+  // different (the LIS's worker threads move the heap, the declaration order changed the sums in the last bits).
+  std::vector<double*> inverse_depths;
+  std::set<const double*> fixed_depths;  // depth_mode fixed: lidar-anchored features (membership only)
   int features = 0, with_lidar_depth = 0, seen_three_times = 0;  // features used; lidar-anchored; >= 3 frames
 };
 
