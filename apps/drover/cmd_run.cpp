@@ -19,6 +19,7 @@
 #include "apps/drover/run_preset.hpp"
 #include "apps/drover/run_realtime.hpp"
 #include "apps/drover/run_vis.hpp"
+#include "io/read_ahead.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "io/odometry/live_config_io.hpp"
@@ -216,6 +217,8 @@ void runOdometry(const RunOptions& o) {
   const io::DatasetOptions dataset_options = datasetOptions(o);
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, dataset_options);
   if (o.realtime) return runRealtimeOdometry(o, config, *reader);
+  // Decoding images and parsing lidar files in a thread of their own, ahead of the odometry: the same stream.
+  reader = io::readAhead(std::move(reader));
   // --no-lidar, or a platform whose dataset section loads no lidar (EuRoC): the VIS alone.
   const bool no_lidar = o.no_lidar || (!dataset_options.load_lidar && !o.no_camera);
   if (no_lidar)

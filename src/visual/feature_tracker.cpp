@@ -15,6 +15,9 @@ namespace drover::visual {
 std::string FeatureTrackerConfig::validate() const {
   if (max_features < 1) return "max_features must be >= 1, got " + std::to_string(max_features);
   if (detect_below < 0) return "detect_below must be >= 0, got " + std::to_string(detect_below);
+  if (!(detect_interval_s >= 0 && detect_interval_s <= 60))
+    return "detect_interval_s must be in [0, 60] s, got " + std::to_string(detect_interval_s);
+  if (detect_urgent_below < 0) return "detect_urgent_below must be >= 0, got " + std::to_string(detect_urgent_below);
   if (!(min_distance >= 0)) return "min_distance must be >= 0 px, got " + std::to_string(min_distance);
   if (flow_window < 3 || flow_window % 2 == 0)
     return "flow_window must be odd and >= 3, got " + std::to_string(flow_window);

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <future>
 #include <memory>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -48,6 +49,11 @@ struct FeatureTrackerConfig {
   bool async_detection = false;     // run the detector in a worker thread (see above)
   int detect_below = 0;             // detect only when fewer live tracks than this (0, or >= max_features: whenever
                                     // below max_features, as VINS-Mono); the VIS's policy for a slow detector
+  // A slow detector that finds fewer features than detect_below (SuperPoint on plain walls) would otherwise run at
+  // every frame: after a detection the next one waits detect_interval_s of image time, unless the live tracks fall
+  // below detect_urgent_below. 0 = no wait.
+  double detect_interval_s = 0;     // [s]
+  int detect_urgent_below = 0;      // [tracks]
   std::string validate() const;     // empty = valid, else names the bad value
 };
 
@@ -131,6 +137,7 @@ class FeatureTracker {
   Time previous_t_ = 0;
   bool has_previous_ = false;
   std::uint64_t next_id_ = 0;
+  std::optional<Time> last_detection_t_;  // the newest frame a detection ran on (or was started on, asynchronously)
   // Asynchronous detection: the job's frame, the frames since, and the job.
   cv::Mat job_gray_;
   std::vector<cv::Mat> frames_since_job_;

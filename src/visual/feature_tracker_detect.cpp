@@ -102,12 +102,18 @@ std::vector<cv::Point2f> carry(std::vector<cv::Point2f> points, const cv::Mat& f
 void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
   cv::Mat mask = crowdMask(result);
   // Detect-when-needed: a slow detector (SuperPoint) runs only when the live tracks fall below detect_below.
-  const bool enough = config_.detect_below > 0 && static_cast<int>(tracks_.size()) >= config_.detect_below;
-  if (enough && !(config_.async_detection && job_.valid())) return;
+  const int live = static_cast<int>(tracks_.size());
+  const bool enough = config_.detect_below > 0 && live >= config_.detect_below;
+  const bool waiting = config_.detect_interval_s > 0 && live > 0 && live >= config_.detect_urgent_below &&
+                       last_detection_t_ && toSeconds(result.t - *last_detection_t_) < config_.detect_interval_s;
+  if ((enough || waiting) && !(config_.async_detection && job_.valid())) return;
   if (!config_.async_detection || tracks_.size() == 0) {
     if (config_.async_detection && job_.valid()) job_.wait();  // the detector serves one caller at a time
     const int wanted = config_.max_features - static_cast<int>(tracks_.size());
-    if (wanted > 0) addDetections(detector_->detect(gray, mask.clone(), detectionCount(wanted)).points, mask, result);
+    if (wanted > 0) {
+      addDetections(detector_->detect(gray, mask.clone(), detectionCount(wanted)).points, mask, result);
+      last_detection_t_ = result.t;
+    }
     if (config_.async_detection && job_.valid()) job_.get();  // superseded by the synchronous detection
     frames_since_job_.clear();
     return;
@@ -117,7 +123,8 @@ void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
     // Carried to this frame, then only where the current mask leaves room.
     addDetections(carry(job_.get().points, job_gray_, frames_since_job_, config_), mask, result);
   }
-  if (!job_.valid() && static_cast<int>(tracks_.size()) < config_.max_features) {
+  if (!job_.valid() && !waiting && static_cast<int>(tracks_.size()) < config_.max_features) {
+    last_detection_t_ = result.t;
     job_gray_ = gray;
     frames_since_job_.clear();
     const int wanted = detectionCount(config_.max_features - static_cast<int>(tracks_.size()));

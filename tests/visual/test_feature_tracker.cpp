@@ -276,10 +276,45 @@ TEST(FeatureTracker, DetectBelowRunsTheDetectorOnlyWhenTheLiveTracksFallBelowIt)
   EXPECT_GT(previous, 60u);
 }
 
+// A slow detector that never fills the window (SuperPoint on plain walls) is held to one run per detect_interval_s
+// of image time, except when the live tracks fall below detect_urgent_below: here a texture sliding 12 px a frame
+// loses tracks at every frame (so detect_below alone would detect at every frame), and a cut to another texture at
+// frame 21 loses them all.
+TEST(FeatureTracker, DetectIntervalHoldsASlowDetectorToOneRunPerIntervalUnlessTracksRunOut) {
+  const auto canvas = testing::texture(1400, 800, 5);
+  const auto other = testing::texture(1400, 800, 9);
+  FeatureTrackerConfig config = baseConfig();
+  config.detect_interval_s = 0.2;  // 4 frames at 20 Hz
+  config.detect_urgent_below = 30;
+  const auto detector = std::make_shared<GfttDetector>();
+  FeatureTracker tracker(pinhole(), detector, config);
+  std::vector<int> ran;
+  for (int i = 0; i < 30; ++i) {
+    const int before = detector->calls;
+    const TrackingResult r = tracker.track(i * kFrameNs, testing::view(i < 21 ? canvas : other, {12.0 * i, 0}, kSize));
+    if (detector->calls > before) ran.push_back(i);
+    if (i == 21) {
+      EXPECT_LT(r.tracked, config.detect_urgent_below) << "the cut must lose the tracks";
+    }
+  }
+  EXPECT_EQ(ran, (std::vector<int>{0, 4, 8, 12, 16, 20, 21, 25, 29}));
+  FeatureTrackerConfig every = baseConfig();
+  const auto plain = std::make_shared<GfttDetector>();
+  FeatureTracker without(pinhole(), plain, every);
+  for (int i = 0; i < 30; ++i) without.track(i * kFrameNs, testing::view(canvas, {12.0 * i, 0}, kSize));
+  EXPECT_EQ(plain->calls, 30) << "without the interval the detector runs at every frame here";
+}
+
 TEST(FeatureTracker, RejectsBadConfigImagesAndTimes) {
   FeatureTrackerConfig bad = baseConfig();
   bad.flow_window = 20;
   EXPECT_NE(bad.validate().find("flow_window"), std::string::npos);
+  FeatureTrackerConfig bad_interval = baseConfig();
+  bad_interval.detect_interval_s = -0.1;
+  EXPECT_NE(bad_interval.validate().find("detect_interval_s"), std::string::npos);
+  bad_interval.detect_interval_s = 0.5;
+  bad_interval.detect_urgent_below = -1;
+  EXPECT_NE(bad_interval.validate().find("detect_urgent_below"), std::string::npos);
   EXPECT_THROW(FeatureTracker(pinhole(), std::make_shared<GfttDetector>(), bad), std::invalid_argument);
   EXPECT_THROW(FeatureTracker(pinhole(), nullptr, baseConfig()), std::invalid_argument);
   FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(), baseConfig());

@@ -66,7 +66,9 @@ void bindTracker(YamlSection& s, visual::FeatureTrackerConfig& c, std::string& c
       .bind("clahe_tiles", c.clahe_tiles)
       .bind("dark_mean", c.dark_mean)
       .bind("async_detection", c.async_detection)
-      .bind("detect_below", c.detect_below);
+      .bind("detect_below", c.detect_below)
+      .bind("detect_interval_s", c.detect_interval_s)
+      .bind("detect_urgent_below", c.detect_urgent_below);
 }
 
 void bindDepth(YamlSection& s, visual::DepthAssociationConfig& c) {

@@ -13,7 +13,8 @@
 //                     flow_epsilon [px], forward_backward (bool), forward_backward_px [px], border_px [px],
 //                     ransac (bool), ransac_threshold_px [px at virtual_focal_px], ransac_confidence,
 //                     virtual_focal_px [px], clahe (off | always | when_dark), clahe_clip, clahe_tiles,
-//                     dark_mean [grey levels], async_detection (bool), detect_below (visual/feature_tracker.hpp)
+//                     dark_mean [grey levels], async_detection (bool), detect_below, detect_interval_s [s],
+//                     detect_urgent_below (visual/feature_tracker.hpp)
 //     depth:          window_s [s], voxel_size [m], grid_resolution_deg [deg], neighbour_cells [cells],
 //                     max_depth_spread [m], min_depth [m], max_depth [m], min_incidence_cos
 //                                                                              (visual/depth_association.hpp)
