@@ -22,7 +22,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from course_report import gt_at, load_tum  # noqa: E402
 
-ROW_ORDER = ["lis", "vis", "lvi-sam", "drover"]
+ROW_ORDER = ["lis", "vis", "lvi-sam", "drover", "drover+superpoint"]
 STATS = ["max", "min", "std", "median", "mean", "rmse"]
 
 
@@ -84,7 +84,7 @@ def main():
             cells = [f"{ape[s]:.3f}" if ape else "-" for s in STATS]
             closed = course.startswith("farm")
             gap = course_json["start_end_m"] if closed else course_json["end_error_m"]
-            name = row if not row.startswith("drover-") else "drover without " + row[len("drover-"):]
+            name = row.replace("drover-", "drover without ", 1).replace("drover+", "drover with ", 1)
             lines.append(f"| {name} | " + " | ".join(cells) + f" | {course_json['drift_percent']:.2f} | {gap:.3f} |")
         lines.append("")
         curves = {}

@@ -64,7 +64,8 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  depth_mode: sometimes\n", "vio.depth_mode"},
            {"vio:\n  window: 2\n", "window must be in [3, 50]"},
            {"vio:\n  sigma_px: -1\n", "sigma_px must be > 0"},
-           {"vio:\n  max_time_offset_s: nan\n", "vio.max_time_offset_s"}}) {
+           {"vio:\n  max_time_offset_s: nan\n", "vio.max_time_offset_s"},
+           {"vio:\n  relative_covariance: often\n", "vio.relative_covariance"}}) {
     try {
       io::loadVioConfig(write(dir, yaml));
       ADD_FAILURE() << "accepted: " << yaml;

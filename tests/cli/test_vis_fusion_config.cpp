@@ -23,7 +23,8 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
            "    sigma_position_ratio: 0.06\n    sigma_rotation: 0.02\n    sigma_rotation_ratio: 0.07\n"
            "    min_features: 25\n    full_features: 90\n    warmup: 1.5\n    max_age: 0.25\n"
            "    max_keyframe_gap: 0.6\n    standing_speed: 0.3\n    max_velocity_difference: 1.1\n"
-           "    max_position_difference: 0.45\n    reset_after: 2.5\n")
+           "    max_position_difference: 0.45\n    reset_after: 2.5\n    window_covariance: true\n"
+           "    window_floor_position: 0.007\n    window_floor_rotation: 0.003\n")
           .vis_fusion;
   EXPECT_FALSE(c.factor);
   EXPECT_FALSE(c.initial_guess);
@@ -40,6 +41,26 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_DOUBLE_EQ(c.max_velocity_difference, 1.1);
   EXPECT_DOUBLE_EQ(c.max_position_difference, 0.45);
   EXPECT_DOUBLE_EQ(c.reset_after, 2.5);
+  EXPECT_TRUE(c.window_covariance);
+  EXPECT_DOUBLE_EQ(c.window_floor_position, 0.007);
+  EXPECT_DOUBLE_EQ(c.window_floor_rotation, 0.003);
+}
+
+// The switches the presets and the ablation turn: odometry.degenerate_pose_from_match and loop.visual_yaw_prior.
+TEST(VisFusionConfigReader, ThePresetsSwitchesReachTheirFieldsAndRejectNonBooleans) {
+  test::TempDir dir;
+  const pipeline::OdometryConfig c =
+      load(dir, "odometry:\n  degenerate_pose_from_match: true\nloop:\n  visual_yaw_prior: false\n");
+  EXPECT_TRUE(c.degenerate_pose_from_match);
+  EXPECT_FALSE(c.loop.visual_yaw_prior);
+  const pipeline::OdometryConfig d = load(dir, "odometry:\n  use_imu: true\n");
+  EXPECT_FALSE(d.degenerate_pose_from_match) << "Drover's own default: the smoother's pose";
+  EXPECT_TRUE(d.loop.visual_yaw_prior);
+  const std::string file = (dir / "odometry.yaml").string();
+  const std::string match = errorOf(dir, "odometry:\n  degenerate_pose_from_match: sometimes\n");
+  EXPECT_TRUE(has(match, file) && has(match, "degenerate_pose_from_match")) << match;
+  const std::string prior = errorOf(dir, "loop:\n  visual_yaw_prior: 2\n");
+  EXPECT_TRUE(has(prior, file) && has(prior, "visual_yaw_prior")) << prior;
 }
 
 TEST(VisFusionConfigReader, BadValuesAndUnknownKeysAreErrorsNamingFileAndKey) {
@@ -51,6 +72,10 @@ TEST(VisFusionConfigReader, BadValuesAndUnknownKeysAreErrorsNamingFileAndKey) {
   EXPECT_TRUE(has(order, file) && has(order, "section 'odometry'") && has(order, "min_features")) << order;
   const std::string zero = errorOf(dir, "odometry:\n  vis_fusion:\n    max_position_difference: 0\n");
   EXPECT_TRUE(has(zero, file) && has(zero, "max_position_difference")) << zero;
+  const std::string floor = errorOf(dir, "odometry:\n  vis_fusion:\n    window_floor_rotation: 0\n");
+  EXPECT_TRUE(has(floor, file) && has(floor, "window_floor_rotation")) << floor;
+  const std::string flag = errorOf(dir, "odometry:\n  vis_fusion:\n    window_covariance: maybe\n");
+  EXPECT_TRUE(has(flag, file) && has(flag, "window_covariance")) << flag;
   const std::string unknown = errorOf(dir, "odometry:\n  vis_fusion:\n    facter: true\n");
   EXPECT_TRUE(has(unknown, "line 3") && has(unknown, "'odometry.vis_fusion.facter'")) << unknown;
 }

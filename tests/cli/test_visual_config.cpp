@@ -148,6 +148,8 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
     clahe_tiles: 4
     dark_mean: 50
     async_detection: true
+    detect_interval_s: 0.5
+    detect_urgent_below: 30
   depth: {window_s: 3, voxel_size: 0.1, grid_resolution_deg: 1, neighbour_cells: 4, max_depth_spread: 1.5,
           min_depth: 3, max_depth: 80, min_incidence_cos: 0.1}
 )");
@@ -170,6 +172,8 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
   EXPECT_EQ(t.clahe_tiles, 4);
   EXPECT_DOUBLE_EQ(t.dark_mean, 50);
   EXPECT_TRUE(t.async_detection);
+  EXPECT_DOUBLE_EQ(t.detect_interval_s, 0.5);
+  EXPECT_EQ(t.detect_urgent_below, 30);
   const visual::DepthAssociationConfig& d = c.depth;
   EXPECT_DOUBLE_EQ(d.window_s, 3);
   EXPECT_DOUBLE_EQ(d.voxel_size, 0.1);
@@ -216,6 +220,8 @@ TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
   EXPECT_TRUE(has(e, "line 3")) << e;
   EXPECT_TRUE(has(e, "visual.tracker")) << e;
   EXPECT_TRUE(has(e, "flow_window must be odd")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    detect_interval_s: -1\n");
+  EXPECT_TRUE(has(e, "line 3") && has(e, "detect_interval_s must be in [0, 60] s")) << e;
   e = errorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
   EXPECT_TRUE(has(e, "visual.depth")) << e;
   EXPECT_TRUE(has(e, "line 3")) << e;
