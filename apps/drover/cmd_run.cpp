@@ -29,6 +29,10 @@
 
 namespace drover::cli {
 namespace {
+
+// Measurements the main loop reads ahead of its own position, so that the VIS's front end can track a frame while
+// the loop processes the ~13 IMU samples and the sweep before it (~2 camera frames at 200 Hz IMU and 15 Hz camera).
+constexpr std::size_t kLookahead = 32;
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
@@ -256,9 +260,29 @@ void runOdometry(const RunOptions& o) {
   std::unique_ptr<RunVis> vis;  // made at the first camera frame (a dataset without images runs the LIS alone)
   std::optional<ImuSample> last_imu;
   bool camera_warned = false;
+  // The VIS's front end runs ahead in a thread of its own (track_ahead.hpp): every frame the loop below will give
+  // the VIS is submitted when it is read, a few measurements before its turn.
+  std::optional<VisSetup> vis_setup;
+  std::unique_ptr<TrackAhead> track_ahead;
+  const auto visTakes = [&](const CameraFrame& frame) {
+    const double since = toSeconds(frame.t - *t_first);
+    return since >= o.start && !(o.duration > 0 && since > o.start + o.duration) &&
+           cameraUsable(reader->calibration(), no_lidar, o, camera_warned);
+  };
+  const auto onRead = [&](const Measurement& m) {
+    if (!t_first) t_first = measurementTime(m);
+    const auto* frame = std::get_if<CameraFrame>(&m);
+    if (frame == nullptr || !visTakes(*frame)) return;
+    if (!track_ahead) {
+      vis_setup = loadVisSetup(o.config, o.method());
+      track_ahead = std::make_unique<TrackAhead>(reader->calibration(), vis_setup->detector, vis_setup->config.tracker);
+    }
+    track_ahead->submit(*frame);
+  };
+  Lookahead ahead(*reader, kLookahead);
   const auto visFor = [&]() -> RunVis& {
     if (!vis) {
-      vis = std::make_unique<RunVis>(o.config, reader->calibration(), config.preintegration, o.method());
+      vis = std::make_unique<RunVis>(*vis_setup, reader->calibration(), config.preintegration);
       if (last_imu) vis->onImu(*last_imu);  // the first frame's interval starts at the sample before it
       if (!no_lidar)
         odometry.setSweepListener([&vis](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
@@ -267,7 +291,7 @@ void runOdometry(const RunOptions& o) {
     }
     return *vis;
   };
-  while (std::optional<Measurement> m = stop.requested() ? std::nullopt : reader->next()) {
+  while (std::optional<Measurement> m = stop.requested() ? std::nullopt : ahead.next(onRead)) {
     showReaderDrops();
     const Time t = measurementTime(*m);
     if (!t_first) t_first = t;
@@ -281,8 +305,8 @@ void runOdometry(const RunOptions& o) {
     if (const auto* scan = std::get_if<LidarScan>(&*m))
       record.scan_times.push_back(scan->t + reader->calibration().lidar_time_offset);
     if (const auto* frame = std::get_if<CameraFrame>(&*m)) {
-      if (!cameraUsable(reader->calibration(), no_lidar, o, camera_warned)) continue;
-      visFor().onFrame(*frame, no_lidar ? nullptr : &odometry);
+      if (!visTakes(*frame)) continue;  // what onRead submitted by: this frame is the oldest submitted
+      visFor().onFrame(*frame, no_lidar ? nullptr : &odometry, track_ahead.get());
       if (!no_lidar)
         if (std::optional<pipeline::VisualState> state = vis->takeState()) odometry.addVisualState(*state);
       continue;

@@ -45,13 +45,14 @@ VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method
 }
 
 RunVis::RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu,
-               const MethodChoice& method) {
-  VisSetup setup = loadVisSetup(config_path, method);
-  detector_name_ = setup.detector_name;
-  vio_config_ = setup.config.vio;
-  own_ = std::make_unique<vio::VisualOdometry>(setup.config, calibration, imu, std::move(setup.detector));
-  vo_ = own_.get();
-}
+               const MethodChoice& method)
+    : RunVis(loadVisSetup(config_path, method), calibration, imu) {}
+
+RunVis::RunVis(const VisSetup& setup, const Calibration& calibration, const imu::PreintegrationConfig& imu)
+    : own_(std::make_unique<vio::VisualOdometry>(setup.config, calibration, imu, setup.detector)),
+      vo_(own_.get()),
+      detector_name_(setup.detector_name),
+      vio_config_(setup.config.vio) {}
 
 RunVis::RunVis(const VisSetup& setup) : detector_name_(setup.detector_name), vio_config_(setup.config.vio) {}
 
@@ -93,7 +94,7 @@ std::optional<vio::SeedState> RunVis::seedAt(Time t, const pipeline::LidarOdomet
   return pipeline::lisSeedAt(lis.recentImuRate(), t, imu::ImuBias{lis_state_->gyro_bias, lis_state_->acc_bias});
 }
 
-void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis) {
+void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis, TrackAhead* ahead) {
   ++frames_in_;
   vio::VisualOdometry::PoseAt pose_at;
   vio::Seeder seed;
@@ -108,7 +109,8 @@ void RunVis::onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* li
   }
   vio::VisFrame f;
   try {
-    f = own_->addFrame(frame, pose_at, seed);
+    f = ahead != nullptr ? own_->addTracked(frame.t, ahead->take(frame), pose_at, seed)
+                         : own_->addFrame(frame, pose_at, seed);
   } catch (const std::invalid_argument& e) {  // wrong size or type, a stamp not after the previous frame's
     if (++frames_bad_ <= 5) spdlog::warn("camera frame {} skipped: {}", frame.source, e.what());
     if (frames_bad_ == 5) spdlog::warn("camera: further skipped frames are counted, not shown");

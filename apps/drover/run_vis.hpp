@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "apps/drover/run_preset.hpp"
+#include "apps/drover/track_ahead.hpp"
 #include "io/reader.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "types/trajectory.hpp"
@@ -41,6 +42,7 @@ class RunVis {
   // The replay: runs its own vio::VisualOdometry (onImu, onFrame, onSweep, onLisState).
   RunVis(const std::string& config_path, const Calibration& calibration, const imu::PreintegrationConfig& imu,
          const MethodChoice& method = {});
+  RunVis(const VisSetup& setup, const Calibration& calibration, const imu::PreintegrationConfig& imu);
   // --realtime: the VisualOdometry runs in pipeline::System; record() each frame it took, and attach() it (after
   // the System's shutdown) for the report.
   explicit RunVis(const VisSetup& setup);
@@ -50,7 +52,8 @@ class RunVis {
 
   void onImu(const ImuSample& sample);
   // A camera frame; lis is the LIS when it runs (nullptr with --no-lidar). A bad image is a counted warning.
-  void onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis);
+  // With `ahead`, the frame's tracks come from it (the frame was submitted there; track_ahead.hpp).
+  void onFrame(const CameraFrame& frame, const pipeline::LidarOdometry* lis, TrackAhead* ahead = nullptr);
   // Every sweep the LIS processed (registered with LidarOdometry::setSweepListener).
   void onSweep(Time t, const Eigen::Isometry3d& T_world_lidar, const std::vector<Eigen::Vector3f>& points_lidar);
   // The newest LIS sweep with a fused IMU state (its velocity and biases seed the VIS), and the LIS's request to

@@ -35,11 +35,22 @@ void VisualOdometry::addSweep(Time t, const Eigen::Isometry3d& T_world_lidar,
 }
 
 VisFrame VisualOdometry::addFrame(const CameraFrame& frame, const PoseAt& lis_pose, const Seeder& seed) {
+  return addTracked(frame.t, track(frame), lis_pose, seed);
+}
+
+visual::TrackingResult VisualOdometry::track(const CameraFrame& frame) {
+  return tracker_.track(frame.t + calibration_.camera_time_offset, visual::imageView(frame.image));
+}
+
+VisFrame VisualOdometry::addTracked(Time frame_t, const visual::TrackingResult& tracks, const PoseAt& lis_pose,
+                                    const Seeder& seed) {
   VisFrame out;
   const auto t0 = Clock::now();
-  const Time t = frame.t + calibration_.camera_time_offset;
-  const visual::TrackingResult tracks = tracker_.track(t, visual::imageView(frame.image));
-  out.ms.track = msSince(t0);
+  const Time t = frame_t + calibration_.camera_time_offset;
+  if (tracks.t != t)
+    throw std::invalid_argument("VisualOdometry::addTracked: tracks of " + std::to_string(tracks.t) +
+                                " ns for the frame at " + std::to_string(t) + " ns");
+  out.ms.track = tracks.ms;
   out.front_tracked = tracks.tracked;
   out.front_added = tracks.added;
   out.detected = tracks.added > 0;
@@ -70,7 +81,7 @@ VisFrame VisualOdometry::addFrame(const CameraFrame& frame, const PoseAt& lis_po
   out.ms.marginalize = out.estimate.ms_marginalize;
   out.ms.covariance = out.estimate.ms_covariance;
   out.share_three = estimator_.featuresInThreeOrMore();
-  out.ms.total = msSince(t0);
+  out.ms.total = tracks.ms + msSince(t0);
   return out;
 }
 

@@ -58,6 +58,12 @@ class VisualOdometry {
   // One camera frame. Throws std::invalid_argument on an image of the wrong size or type (the caller warns and
   // skips it).
   VisFrame addFrame(const CameraFrame& frame, const PoseAt& lis_pose, const Seeder& seed);
+  // addFrame in two steps, so that the front end can run ahead in another thread: track() touches only the KLT
+  // tracker, addTracked() everything else, so one thread may track frame k+1 while another adds frame k. Frames must
+  // be tracked in time order, and each added with its own tracks (frame_t: CameraFrame::t; a mismatch throws
+  // std::invalid_argument). addFrame(f) is addTracked(f.t, track(f)).
+  visual::TrackingResult track(const CameraFrame& frame);
+  VisFrame addTracked(Time frame_t, const visual::TrackingResult& tracks, const PoseAt& lis_pose, const Seeder& seed);
   const SlidingWindowEstimator& estimator() const { return estimator_; }
   // The LIS asks the VIS to start again (its gates refused it too long, pipeline::VisualWatch): the window is
   // cleared and re-initialises from the LIS's state at the next frames; the tracker's features carry on.
