@@ -19,11 +19,11 @@
 #include "apps/drover/run_preset.hpp"
 #include "apps/drover/run_realtime.hpp"
 #include "apps/drover/run_vis.hpp"
-#include "io/read_ahead.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "io/odometry/live_config_io.hpp"
 #include "io/odometry/odometry_config_io.hpp"
+#include "io/read_ahead.hpp"
 #include "pipeline/lidar_odometry.hpp"
 #include "visual/camera_model.hpp"
 
@@ -33,6 +33,7 @@ namespace {
 // Measurements the main loop reads ahead of its own position, so that the VIS's front end can track a frame while
 // the loop processes the ~13 IMU samples and the sweep before it (~2 camera frames at 200 Hz IMU and 15 Hz camera).
 constexpr std::size_t kLookahead = 32;
+
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
