@@ -107,6 +107,9 @@ class SlidingWindowEstimator {
   std::string failure(const FrameResult& previous_output) const;
   void slide(bool keyframe, FrameResult& result);
   void declareWindowBlocks(backend::SchurMarginalizer& m);
+  // declareWindowBlocks, then the window's residuals (buildResiduals) and their feature blocks declared in the
+  // features' order: what the marginalisation and the relative covariance start from.
+  Residuals declareWindow(backend::SchurMarginalizer& m, bool for_marginalization_of_oldest);
   // A held (depth_mode fixed) lidar depth as a tight inverse-depth factor, so that a Schur complement conditions on
   // it rather than forgetting it (window_marginalize.cpp; the marginalisation and the relative covariance).
   struct HeldDepth {

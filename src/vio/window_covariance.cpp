@@ -35,10 +35,7 @@ constexpr double kConstantSigma = 1e-6;   // [m, rad, s] an extrinsic or time of
 std::optional<Eigen::Matrix<double, 6, 6>> SlidingWindowEstimator::newestRelativeCovariance() {
   if (frames_.size() < 2) return std::nullopt;
   backend::SchurMarginalizer m;
-  declareWindowBlocks(m);
-  Residuals r;
-  buildResiduals(r, false);
-  for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
+  const Residuals r = declareWindow(m, false);
   const std::vector<HeldDepth> depths = heldDepths(r);
   for (const HeldDepth& h : depths) m.addResidual(h.factor.get(), nullptr, {h.inverse_depth});
   std::vector<std::unique_ptr<ceres::CostFunction>> held;

@@ -38,6 +38,15 @@ void SlidingWindowEstimator::declareWindowBlocks(backend::SchurMarginalizer& m) 
   m.addBlock(td_, 1, nullptr);
 }
 
+SlidingWindowEstimator::Residuals SlidingWindowEstimator::declareWindow(backend::SchurMarginalizer& m,
+                                                                      bool oldest_only) {
+  declareWindowBlocks(m);
+  Residuals r;
+  buildResiduals(r, oldest_only);
+  for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
+  return r;
+}
+
 std::vector<SlidingWindowEstimator::HeldDepth> SlidingWindowEstimator::heldDepths(const Residuals& r) {
   std::vector<HeldDepth> out;
   for (auto& [id, f] : features_.features())
@@ -49,10 +58,7 @@ std::vector<SlidingWindowEstimator::HeldDepth> SlidingWindowEstimator::heldDepth
 
 void SlidingWindowEstimator::marginalizeOldest() {
   backend::SchurMarginalizer m;
-  declareWindowBlocks(m);
-  Residuals r;
-  buildResiduals(r, true);
-  for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
+  const Residuals r = declareWindow(m, true);
   const std::vector<HeldDepth> held = heldDepths(r);
   if (prior_) m.addResidual(prior_.get(), nullptr, prior_->blocks());
   for (auto& item : r.items) m.addResidual(item.cost.get(), item.loss, item.blocks);
