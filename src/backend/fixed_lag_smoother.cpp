@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/SVD>
 
 #include <algorithm>
 #include <cmath>
@@ -140,6 +141,11 @@ void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias
   impl_->window.prior.sqrt_information.block<6, 6>(9, 9) = *U;  // gyro rows 9..11, accelerometer 12..14
 }
 
+// The window's Gauss-Newton information H = J^T J at the current estimate, with J the whitened Jacobian in the
+// tangent spaces of the blocks taken in the window's order (p, q, v, b of each node, oldest first), and its
+// inverse's block of the newest bias. Not ceres::Covariance: that orders its columns by the blocks' addresses,
+// which differ from run to run (each node is its own allocation), so its last bits did too, and through a loop
+// correction's restart (ImuFusion::reanchor) every replay with a loop closure differed from its first loop on.
 std::optional<Eigen::Matrix<double, 6, 6>> FixedLagSmoother::biasCovariance() const {
   if (!impl_->initialized) return std::nullopt;
   SmootherWindow window = impl_->window;  // the problem points into the nodes: a copy keeps this const
@@ -148,15 +154,27 @@ std::optional<Eigen::Matrix<double, 6, 6>> FixedLagSmoother::biasCovariance() co
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
   window.buildProblem(problem, &manifold);
-  ceres::Covariance::Options options;
-  options.algorithm_type = ceres::DENSE_SVD;  // ~160 parameters: cheap, and robust to a weak direction
-  ceres::Covariance covariance(options);
-  const double* b = window.nodes.back().b.data();
-  const std::vector<std::pair<const double*, const double*>> blocks = {{b, b}};
-  if (!covariance.Compute(blocks, &problem)) return std::nullopt;
-  Eigen::Matrix<double, 6, 6, Eigen::RowMajor> C;
-  if (!covariance.GetCovarianceBlock(b, b, C.data()) || !C.allFinite()) return std::nullopt;
-  return Eigen::Matrix<double, 6, 6>(C);
+  ceres::Problem::EvaluateOptions evaluate;
+  for (WindowNode& node : window.nodes)
+    for (double* block : node.blocks()) evaluate.parameter_blocks.push_back(block);
+  ceres::CRSMatrix crs;
+  if (!problem.Evaluate(evaluate, nullptr, nullptr, nullptr, &crs)) return std::nullopt;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row)
+    for (int k = crs.rows[static_cast<std::size_t>(row)]; k < crs.rows[static_cast<std::size_t>(row) + 1]; ++k)
+      J(row, crs.cols[static_cast<std::size_t>(k)]) = crs.values[static_cast<std::size_t>(k)];
+  // H^-1 = V S^-2 V^T from J's singular value decomposition (not from H, whose condition is J's squared). Refused,
+  // as ceres::Covariance's DENSE_SVD refuses it with its default min_reciprocal_condition_number 1e-14, when
+  // (sigma_min / sigma_max)^2 < 1e-14.
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(J, Eigen::ComputeThinV);
+  const Eigen::VectorXd sigma = svd.singularValues();  // descending
+  if (sigma.size() != J.cols() || !sigma.allFinite() ||
+      !(sigma(sigma.size() - 1) * sigma(sigma.size() - 1) > 1e-14 * sigma(0) * sigma(0)))
+    return std::nullopt;
+  const Eigen::MatrixXd V = svd.matrixV().bottomRows(6);  // the newest node's bias: the last tangent block
+  const Eigen::Matrix<double, 6, 6> C = V * sigma.cwiseAbs2().cwiseInverse().asDiagonal() * V.transpose();
+  if (!C.allFinite()) return std::nullopt;
+  return Eigen::Matrix<double, 6, 6>(0.5 * (C + C.transpose()));
 }
 
 std::optional<Eigen::Matrix3d> FixedLagSmoother::gyroBiasCovariance() const {
