@@ -159,16 +159,18 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   }
   const Eigen::Matrix<double, 6, 6> L = poseSqrtInformation(out, T_world_imu_measured);
   std::optional<backend::RelativePoseMeasurement> visual;
-  if (config_.vis_fusion.factor && !visual_.empty()) {
+  // The VIS is checked (and watched) whenever the LIS takes it, as a factor or only as the matcher's guess.
+  if ((config_.vis_fusion.factor || config_.vis_fusion.initial_guess) && !visual_.empty()) {
     std::string why;
     bool disagreed = false;
-    if (const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, out.t, &why, &disagreed)) {
+    const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, out.t, &why, &disagreed);
+    if (inc && config_.vis_fusion.factor) {
       visual = backend::RelativePoseMeasurement{inc->T_a_b, inc->sqrt_information};
       out.vis_factor = true;
-    } else {
+    } else if (!inc) {
       out.vis_unused = why;
     }
-    out.vis_reset = visual_watch_.onSweep(out.t, out.vis_factor, disagreed ? why : std::string());
+    out.vis_reset = visual_watch_.onSweep(out.t, inc.has_value(), disagreed ? why : std::string());
   }
   backend::SmootherUpdate r;
   try {
@@ -192,7 +194,13 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   out.gyro_bias = r.bias.gyro;
   out.acc_bias = r.bias.acc;
   const Eigen::Isometry3d T_world_lidar_fused = r.state.T_world_imu * T_imu_lidar_;
-  if (!out.match_usable || (out.degenerate && !config_.degenerate_pose_from_match)) {
+  // A degenerate match whose guess was the VIS's motion, when no VO factor told the smoother that motion, holds the
+  // VIS along its degenerate directions (Zhang's remapping keeps them at the guess); the smoother saw the VIS only
+  // through the match's loosened directions and drifts there: the match is the pose (as LIO-SAM's). Without this a
+  // guess-only Drover drifted 38.9 % in the corridor, and the VIS, taking its depths from the drifting LIS, with it.
+  const bool guess_holds_degenerate = out.vis_guess && !out.vis_factor;
+  const bool pose_from_match = config_.degenerate_pose_from_match || guess_holds_degenerate;
+  if (!out.match_usable || (out.degenerate && !pose_from_match)) {
     // The lidar left some directions (or all) to the IMU: the fused state is the pose.
     out.T_world_lidar = T_world_lidar_fused;
   } else if (config_.gravity_roll_pitch) {
