@@ -195,7 +195,9 @@ TEST(VisualConfigReader, ShippedConfigsGiveTheTrackerAndDepthDefaults) {
     EXPECT_DOUBLE_EQ(c.tracker.forward_backward_px, t.forward_backward_px);
     EXPECT_EQ(c.tracker.clahe, t.clahe);
     EXPECT_DOUBLE_EQ(c.tracker.dark_mean, t.dark_mean);
-    EXPECT_EQ(c.detector.superpoint.post.min_keypoints, 0) << "the floor is off (bench/RESULTS.md)";
+    // The floor is off for real frames; the simulated farm's rendered frames score low and need it (bench/RESULTS.md).
+    const bool rendered = std::string(name) == "farm_sim.yaml";
+    EXPECT_EQ(c.detector.superpoint.post.min_keypoints, rendered ? 150 : 0);
     EXPECT_DOUBLE_EQ(c.depth.min_depth, visual::DepthAssociationConfig{}.min_depth);
     EXPECT_DOUBLE_EQ(c.depth.max_depth_spread, visual::DepthAssociationConfig{}.max_depth_spread);
   }
