@@ -77,10 +77,9 @@ class FixedLagSmoother {
   // also when the covariance is not finite, symmetric and positive definite.
   void initialize(const imu::NavState& state, const imu::ImuBias& bias, const imu::PreintegrationConfig& imu,
                   const Eigen::Matrix3d& gyro_bias_covariance);
-  // The newest state's gyro bias marginal covariance [(rad/s)^2] given everything in the window (the inverse
-  // of the window's Gauss-Newton information at the current estimate; bit-identical for equal windows wherever
-  // their states lie in memory). Nothing when not initialized or when the
-  // covariance cannot be computed.
+  // The newest state's gyro bias marginal covariance [(rad/s)^2] given everything in the window (the inverse of
+  // the window's Gauss-Newton information at the current estimate; bit-identical for equal windows wherever their
+  // states lie in memory). Nothing when not initialized or when the covariance cannot be computed.
   std::optional<Eigen::Matrix3d> gyroBiasCovariance() const;
   // The same for both biases, [gyro (rad/s); acc (m/s^2)] (6x6), and a restart with that prior on both: for a
   // restart after a correction that turned the world about gravity only, which changes neither bias.

@@ -37,7 +37,8 @@ struct OdometryConfig {
   bool gravity_roll_pitch = true;
   // A degenerate match's pose: false (Drover) the smoother's fused state, which carries the degenerate directions by
   // the IMU and the VIS's motion factor; true (LIO-SAM / LVI-SAM) the scan match's own, whose degenerate directions
-  // Zhang's remapping keeps at the initial guess (LVI-SAM's VIS motion when it is the guess).
+  // Zhang's remapping keeps at the initial guess (LVI-SAM's VIS motion when it is the guess). Either way a sweep
+  // whose guess was the VIS's motion and which got no VO factor keeps the match's pose (ImuFusion::update).
   bool degenerate_pose_from_match = false;
   // Without an IMU the sweep is deskewed with the constant-velocity motion of the previous sweeps; that closes a
   // feedback loop (a pose error skews the next deskew, which skews the next pose) that can oscillate. After the
