@@ -8,8 +8,8 @@
 # Usage: bash bench/eval_ablation.sh            (all rows on corridor white-walls lighting farm farm-2 farm-3)
 #   ABLATION_COURSES="corridor farm" ABLATION_ROWS="lis lvi-sam drover" bash bench/eval_ablation.sh
 #   ABLATION_LOOPS=0: without loop closure (the default runs with it).
-#   ABLATION_DROVER_EXTRA="--without superpoint": appended to the vis row and every drover row (SuperPoint costs
-#   ~0.7 s a frame on 2 cores: the 650 s farm course takes ~2 h with it). The row drover+superpoint is the whole preset regardless.
+#   ABLATION_DROVER_EXTRA="--without superpoint": appended to the vis row and every drover row (Shi-Tomasi rows:
+#   the farm course takes ~6.5 min a row instead of ~9.5). The row drover+superpoint is the whole preset regardless.
 # Courses are generated once into $DROVER_OUT/sim/<course>-cam (farm-N: seed N; kitti05-replay needs ../shared/data
 # and ~14 GB with its camera). Runs are kept in $DROVER_OUT/ablation/<course>/<row>.
 set -euo pipefail
