@@ -74,11 +74,16 @@ void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
   state.T_world_imu = T_world_imu0_;
   restart(state, r.bias);
   initialized_ = true;
+  sweeps_to_moving_restart_ = config_.moving_start_restart;
+  static_start_ = r.is_static;
+  start_bias_ = r.bias;
+  t_start_ = t0;
   init_note_ = r.is_static
                    ? fmt::format("static start: gravity {:.3f} m/s^2, gyro bias ({:.4f}, {:.4f}, {:.4f}) rad/s{}",
                                  r.gravity_magnitude, r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z(),
                                  r.used_orientation ? ", attitude from the 9-axis orientation" : "")
-                   : "moving start (" + r.reason + "): attitude from the mean specific force, velocity 0";
+                   : "moving start (" + r.reason + "): attitude from the " +
+                         (r.used_orientation ? "9-axis orientation" : "mean specific force") + ", velocity 0";
 }
 
 void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias,
@@ -118,6 +123,23 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
   }
 }
 
+bool ImuFusion::restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3d& T_world_imu_measured,
+                                        const Trajectory& trajectory) {
+  if (sweeps_to_moving_restart_ == 0 || --sweeps_to_moving_restart_ > 0) return false;
+  const double dt = trajectory.empty() ? 0.0 : toSeconds(out.t - trajectory.back().t);
+  if (!out.match_usable || out.degenerate || !(dt > 0)) {
+    sweeps_to_moving_restart_ = 1;  // no lidar velocity from this sweep: the next one
+    return false;
+  }
+  const Eigen::Isometry3d T_world_imu_previous = trajectory.back().T_world_body * T_lidar_imu_;
+  const Eigen::Vector3d v_world = (T_world_imu_measured.translation() - T_world_imu_previous.translation()) / dt;
+  if (static_start_ && v_world.norm() <= config_.moving_start_speed) return false;  // at rest indeed
+  restart({out.t, T_world_imu_measured, v_world}, start_bias_);
+  init_note_ += fmt::format("; moving at {:.2f} m/s by the lidar: the smoother restarted {:.2f} s in with that velocity",
+                            v_world.norm(), toSeconds(out.t - t_start_));
+  return true;
+}
+
 std::optional<imu::FusedState> ImuFusion::fusedState() const {
   if (!initialized_ || !smoother_.initialized()) return std::nullopt;
   return imu::FusedState{smoother_.state(), smoother_.bias()};
@@ -150,6 +172,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   const imu::NavState previous = smoother_.state();
   if (out.t <= previous.t) return;  // the first sweep: the smoother starts there
   const Eigen::Isometry3d T_world_imu_measured = out.T_world_lidar * T_lidar_imu_;
+  if (restartAfterMovingStart(out, T_world_imu_measured, trajectory)) return;
   const std::vector<ImuSample> samples = propagator_.samplesCovering(previous.t, out.t);
   if (samples.empty()) {
     appendWarning(out, "IMU does not cover the sweep: smoother restarted at the lidar pose");

@@ -82,6 +82,10 @@ class ImuFusion {
   // `disagreed` (optional) is set when a VIS increment existed but the gates refused it.
   std::optional<VisualIncrement> checkedVisualIncrement(Time a, Time b, std::string* why,
                                                         bool* disagreed = nullptr) const;
+  // Counts the sweeps after initialising down; at the config's sweep restarts the smoother with the lidar's velocity
+  // when the start was moving (true then).
+  bool restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3d& T_world_imu_measured,
+                               const Trajectory& trajectory);
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
 
   OdometryConfig config_;
@@ -92,6 +96,10 @@ class ImuFusion {
   VisualMotion visual_;
   VisualWatch visual_watch_;
   bool initialized_ = false, given_up_ = false;
+  Time t_start_ = 0;                  // [ns] the first sweep's stamp
+  int sweeps_to_moving_restart_ = 0;  // > 0 after initialising: sweeps left until the moving-start check
+  bool static_start_ = false;
+  imu::ImuBias start_bias_;
   std::string init_note_ = "no IMU data";
   Eigen::Isometry3d T_world_imu0_ = Eigen::Isometry3d::Identity();
 };

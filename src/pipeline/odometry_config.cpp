@@ -29,6 +29,10 @@ LoopClosureConfig OdometryConfig::loopClosure() const {
 std::string OdometryConfig::validate() const {
   if (deskew_refinements < 0 || deskew_refinements > 10)
     return "deskew_refinements must be in [0, 10], got " + std::to_string(deskew_refinements);
+  if (!(moving_start_speed >= 0))
+    return "moving_start_speed must be finite and >= 0, got " + std::to_string(moving_start_speed);
+  if (moving_start_restart < 0)
+    return "moving_start_restart must be >= 0, got " + std::to_string(moving_start_restart);
   if (degenerate_restart_sweeps < 0)
     return "degenerate_restart_sweeps must be >= 0, got " + std::to_string(degenerate_restart_sweeps);
   if (min_points < 1) return "min_points must be >= 1, got " + std::to_string(min_points);

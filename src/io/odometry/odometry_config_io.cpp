@@ -158,6 +158,8 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .bind("degenerate_pose_from_match", c.degenerate_pose_from_match)
       .bind("deskew_refinements", c.deskew_refinements)
       .bind("degenerate_restart_sweeps", c.degenerate_restart_sweeps)
+      .bind("moving_start_restart", c.moving_start_restart)
+      .bind("moving_start_speed", c.moving_start_speed)
       .bind("use_imu_orientation", c.initializer.use_orientation)
       .nested("layout", [&](YamlSection& s) { bindLayout(s, c.layout, e); })
       .nested("features", [&](YamlSection& s) { bindFeatures(s, c.features, f); })
