@@ -187,7 +187,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     std::string why;
     bool disagreed = false;
     const std::optional<VisualIncrement> inc = checkedVisualIncrement(previous.t, out.t, &why, &disagreed);
-    if (inc && config_.vis_fusion.factor) {
+    if (inc && config_.vis_fusion.factor && (out.degenerate || !config_.vis_fusion.factor_degenerate_only)) {
       visual = backend::RelativePoseMeasurement{inc->T_a_b, inc->sqrt_information};
       out.vis_factor = true;
     } else if (!inc) {

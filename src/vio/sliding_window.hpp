@@ -138,6 +138,7 @@ class SlidingWindowEstimator {
   double share_three_ = 0;
   bool deterministic_ = true;
   bool solver_failed_ = false;
+  std::string seed_note_;  // how the last seed agreed with the tracks (vio/seed_agreement.hpp)
   bool waiting_for_older_ = false;  // initialisation waits for a seed the oldest frame predates
   // The initialisation's knowledge of the oldest frame (pose, velocity, biases) as a prior with these sigmas
   // (tangent order p, theta, v, b_g, b_a); it holds the gauge and the tilt / accelerometer-bias ambiguity of a

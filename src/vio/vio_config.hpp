@@ -54,6 +54,11 @@ struct VioConfig {
   double lis_sigma_velocity = 0.5;       // [m/s] (weak: the seed is a finite difference; a tight one fixes its error)
   double lis_sigma_gyro_bias = 0.005;    // [rad/s]
   double lis_sigma_acc_bias = 0.1;       // [m/s^2]
+  // A seed is refused when the window's lidar-anchored tracks, moved by the LIS's poses, reproject to a median
+  // error above seed_max_median_px [px at focal_px] over at least seed_min_observations observations (sliding
+  // tracks on a textureless surface, or a LIS whose velocity drifted; vio/seed_agreement.hpp). 0 disables.
+  double seed_max_median_px = 3.0;
+  int seed_min_observations = 30;
   double align_sigma_rotation_rad = 0.03;  // [rad]
   double align_sigma_velocity = 0.5;       // [m/s]
   double align_sigma_gyro_bias = 0.01;     // [rad/s]

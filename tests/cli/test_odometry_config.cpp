@@ -104,7 +104,8 @@ TEST(OdometryConfigReader, EveryTopLevelKeyReachesItsOwnField) {
                                 "odometry:\n  use_imu: false\n  deskew: false\n  min_points: 50\n  imu_wait: 0.2\n"
                                 "  lidar_sigma_position: 0.04\n  lidar_sigma_rotation: 0.03\n  degenerate_sigma: 5\n"
                                 "  gravity_roll_pitch: false\n  deskew_refinements: 2\n"
-                                "  degenerate_restart_sweeps: 11\n  use_imu_orientation: false\n");
+                                "  degenerate_restart_sweeps: 11\n  use_imu_orientation: false\n"
+                                "  moving_start_restart: 5\n  moving_start_speed: 0.4\n");
   EXPECT_FALSE(c.use_imu);
   EXPECT_FALSE(c.deskew);
   EXPECT_EQ(c.min_points, 50);
@@ -115,6 +116,8 @@ TEST(OdometryConfigReader, EveryTopLevelKeyReachesItsOwnField) {
   EXPECT_FALSE(c.gravity_roll_pitch);
   EXPECT_EQ(c.deskew_refinements, 2);
   EXPECT_EQ(c.degenerate_restart_sweeps, 11);
+  EXPECT_EQ(c.moving_start_restart, 5);
+  EXPECT_DOUBLE_EQ(c.moving_start_speed, 0.4);
   EXPECT_FALSE(c.initializer.use_orientation);
   EXPECT_TRUE(OdometryConfig{}.initializer.use_orientation) << "a 9-axis unit's orientation is used by default";
 }

@@ -32,6 +32,8 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   init: visual
   init_min_acc_excitation: 0.1
   lis_sigma_rotation_rad: 0.02
+  seed_max_median_px: 4.5
+  seed_min_observations: 40
   max_imu_gap_s: 0.2
   imu_midpoint: false
 )"));
@@ -46,6 +48,8 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   EXPECT_EQ(c.init, vio::InitMode::kVisual);
   EXPECT_DOUBLE_EQ(c.init_min_acc_excitation, 0.1);
   EXPECT_DOUBLE_EQ(c.lis_sigma_rotation_rad, 0.02);
+  EXPECT_DOUBLE_EQ(c.seed_max_median_px, 4.5);
+  EXPECT_EQ(c.seed_min_observations, 40);
   EXPECT_DOUBLE_EQ(c.max_imu_gap_s, 0.2);
   EXPECT_FALSE(c.imu_midpoint);
 }

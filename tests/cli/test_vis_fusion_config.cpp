@@ -19,7 +19,8 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
   test::TempDir dir;
   const pipeline::VisualMotionConfig c =
       load(dir,
-           "odometry:\n  vis_fusion:\n    factor: false\n    initial_guess: false\n    sigma_position: 0.03\n"
+           "odometry:\n  vis_fusion:\n    factor: false\n    factor_degenerate_only: true\n    initial_guess: false\n"
+           "    sigma_position: 0.03\n"
            "    sigma_position_ratio: 0.06\n    sigma_rotation: 0.02\n    sigma_rotation_ratio: 0.07\n"
            "    min_features: 25\n    full_features: 90\n    warmup: 1.5\n    max_age: 0.25\n"
            "    max_keyframe_gap: 0.6\n    standing_speed: 0.3\n    max_velocity_difference: 1.1\n"
@@ -27,6 +28,7 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
            "    window_floor_position: 0.007\n    window_floor_rotation: 0.003\n")
           .vis_fusion;
   EXPECT_FALSE(c.factor);
+  EXPECT_TRUE(c.factor_degenerate_only);
   EXPECT_FALSE(c.initial_guess);
   EXPECT_DOUBLE_EQ(c.sigma_position, 0.03);
   EXPECT_DOUBLE_EQ(c.sigma_position_ratio, 0.06);

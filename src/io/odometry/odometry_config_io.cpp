@@ -109,6 +109,7 @@ void bindSmoother(YamlSection& s, backend::FixedLagSmootherConfig& c) {
 
 void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
   s.bind("factor", c.factor)
+      .bind("factor_degenerate_only", c.factor_degenerate_only)
       .bind("initial_guess", c.initial_guess)
       .bind("sigma_position", c.sigma_position)
       .bind("sigma_position_ratio", c.sigma_position_ratio)

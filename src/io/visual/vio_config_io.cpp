@@ -54,6 +54,8 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
       .bind("init_sigma_position_m", c.init_sigma_position_m)
       .bind("lis_sigma_rotation_rad", c.lis_sigma_rotation_rad)
       .bind("lis_sigma_velocity", c.lis_sigma_velocity)
+      .bind("seed_max_median_px", c.seed_max_median_px)
+      .bind("seed_min_observations", c.seed_min_observations)
       .bind("lis_sigma_gyro_bias", c.lis_sigma_gyro_bias)
       .bind("lis_sigma_acc_bias", c.lis_sigma_acc_bias)
       .bind("align_sigma_rotation_rad", c.align_sigma_rotation_rad)
