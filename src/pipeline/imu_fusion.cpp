@@ -74,7 +74,7 @@ void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
   state.T_world_imu = T_world_imu0_;
   restart(state, r.bias);
   initialized_ = true;
-  sweeps_to_moving_restart_ = config_.moving_start_restart;
+  sweeps_to_moving_restart_ = config_.moving_start_restart > 0 ? config_.moving_start_restart : kDone;
   static_start_ = r.is_static;
   start_bias_ = r.bias;
   t_start_ = t0;
@@ -125,12 +125,17 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
 
 bool ImuFusion::restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3d& T_world_imu_measured,
                                         const Trajectory& trajectory) {
-  if (sweeps_to_moving_restart_ == 0 || --sweeps_to_moving_restart_ > 0) return false;
+  // Counts down to the configured sweep, then below zero through the retries a sweep without a lidar velocity
+  // (a failed or degenerate match) costs; a start still unjudged a second later is left as it is: by then the
+  // lidar's velocity says nothing about the start.
+  constexpr int kRetries = 10;  // [sweeps]
+  if (sweeps_to_moving_restart_ == kDone || --sweeps_to_moving_restart_ > 0) return false;
   const double dt = trajectory.empty() ? 0.0 : toSeconds(out.t - trajectory.back().t);
   if (!out.match_usable || out.degenerate || !(dt > 0)) {
-    sweeps_to_moving_restart_ = 1;  // no lidar velocity from this sweep: the next one
+    if (sweeps_to_moving_restart_ < -kRetries) sweeps_to_moving_restart_ = kDone;
     return false;
   }
+  sweeps_to_moving_restart_ = kDone;
   const Eigen::Isometry3d T_world_imu_previous = trajectory.back().T_world_body * T_lidar_imu_;
   const Eigen::Vector3d v_world = (T_world_imu_measured.translation() - T_world_imu_previous.translation()) / dt;
   if (static_start_ && v_world.norm() <= config_.moving_start_speed) return false;  // at rest indeed

@@ -4,6 +4,7 @@
 // lidar pose with the preintegrated IMU to estimate velocity and biases. Failure of the smoother (implausible
 // velocity or bias) resets it at the lidar pose, as LIO-SAM's failureDetection does.
 #include <Eigen/Geometry>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -97,7 +98,9 @@ class ImuFusion {
   VisualWatch visual_watch_;
   bool initialized_ = false, given_up_ = false;
   Time t_start_ = 0;                  // [ns] the first sweep's stamp
-  int sweeps_to_moving_restart_ = 0;  // > 0 after initialising: sweeps left until the moving-start check
+  // Sweeps left until the moving-start check (> 0), then its retries (<= 0); kDone when judged or disabled.
+  static constexpr int kDone = std::numeric_limits<int>::min();
+  int sweeps_to_moving_restart_ = kDone;
   bool static_start_ = false;
   imu::ImuBias start_bias_;
   std::string init_note_ = "no IMU data";

@@ -242,8 +242,8 @@ bool SlidingWindowEstimator::initializeFromSeed(const Seeder& seed, std::string&
   const SeedAgreement agreement = seedAgreement(features_, T_wc, config_.focal_px);
   seed_note_ = fmt::format("its motion reprojects the lidar-depth tracks to a median {:.1f} px over {}",
                            agreement.median_px, agreement.observations);
-  if (config_.seed_max_median_px > 0 && agreement.observations >= static_cast<std::size_t>(config_.seed_min_observations) &&
-      agreement.median_px > config_.seed_max_median_px) {
+  const bool enough = agreement.observations >= static_cast<std::size_t>(config_.seed_min_observations);
+  if (config_.seed_max_median_px > 0 && enough && agreement.median_px > config_.seed_max_median_px) {
     why = "the LIS's seed disagrees with the tracks: " + seed_note_ +
           fmt::format(" (> {:.1f} px)", config_.seed_max_median_px);
     for (auto& [id, f] : features_.features())
