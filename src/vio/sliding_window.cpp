@@ -188,7 +188,7 @@ bool SlidingWindowEstimator::tryInitialize(const Seeder& seed, FrameResult& resu
   // LVI-SAM: while the LIS runs, the VIS starts from its state; the window waits until the LIS covers it.
   if (config_.init == InitMode::kLis || (config_.init == InitMode::kAuto && seed)) {
     ok = initializeFromSeed(seed, why);
-    if (ok) result.event = "initialised from the LIS (" + seed_note_ + ")";
+    if (ok) result.event = "initialised from the LIS (" + why + ")";
     // Frames older than the LIS's first state can never be seeded: let the oldest go.
     waiting_for_older_ = !ok && seed && !seed(frames_.front()->t) && seed(frames_.back()->t);
   } else {
@@ -240,12 +240,12 @@ bool SlidingWindowEstimator::initializeFromSeed(const Seeder& seed, std::string&
   const std::vector<Eigen::Isometry3d> T_wc = cameraPoses();
   features_.initializeDepths(T_wc, config_.depth_mode != DepthMode::kOff);
   const SeedAgreement agreement = seedAgreement(features_, T_wc, config_.focal_px);
-  seed_note_ = fmt::format("its motion reprojects the lidar-depth tracks to a median {:.1f} px over {}",
-                           agreement.median_px, agreement.observations);
+  // On success `why` says how the seed agreed (the event's detail, as the visual alignment's).
+  why = fmt::format("its motion reprojects the lidar-depth tracks to a median {:.1f} px over {}", agreement.median_px,
+                    agreement.observations);
   const bool enough = agreement.observations >= static_cast<std::size_t>(config_.seed_min_observations);
   if (config_.seed_max_median_px > 0 && enough && agreement.median_px > config_.seed_max_median_px) {
-    why = "the LIS's seed disagrees with the tracks: " + seed_note_ +
-          fmt::format(" (> {:.1f} px)", config_.seed_max_median_px);
+    why = fmt::format("the LIS's seed disagrees with the tracks: {} (> {:.1f} px)", why, config_.seed_max_median_px);
     for (auto& [id, f] : features_.features())
       if (!f.lidar_anchor) f.depth = 0;  // triangulated with the refused poses
     return false;

@@ -98,7 +98,7 @@ class SlidingWindowEstimator {
   void integrate(Frame& frame, const Frame& previous) const;
   void predict(Frame& frame, const Frame& previous) const;
   bool tryInitialize(const Seeder& seed, FrameResult& result);
-  bool initializeFromSeed(const Seeder& seed, std::string& why);
+  bool initializeFromSeed(const Seeder& seed, std::string& why);  // why: the refusal, or how the seed agreed
   bool initializeVisually(std::string& why);
   std::vector<Eigen::Isometry3d> cameraPoses() const;
   void optimize(FrameResult& result);
@@ -138,7 +138,6 @@ class SlidingWindowEstimator {
   double share_three_ = 0;
   bool deterministic_ = true;
   bool solver_failed_ = false;
-  std::string seed_note_;  // how the last seed agreed with the tracks (vio/seed_agreement.hpp)
   bool waiting_for_older_ = false;  // initialisation waits for a seed the oldest frame predates
   // The initialisation's knowledge of the oldest frame (pose, velocity, biases) as a prior with these sigmas
   // (tangent order p, theta, v, b_g, b_a); it holds the gauge and the tilt / accelerometer-bias ambiguity of a

@@ -358,6 +358,14 @@ TEST(OdometryConfigReader, AValueThatFailsValidationIsAnErrorNamingFileAndTheOdo
   EXPECT_TRUE(has(w, file) && has(w, "section 'odometry'") && has(w, "window")) << w;
 }
 
+TEST(OdometryConfigReader, ANegativeMovingStartSettingIsAnErrorNamingTheKey) {
+  test::TempDir dir;
+  const std::string r = errorOf(dir, "odometry:\n  moving_start_restart: -1\n");
+  EXPECT_TRUE(has(r, "section 'odometry'") && has(r, "moving_start_restart must be >= 0")) << r;
+  const std::string v = errorOf(dir, "odometry:\n  moving_start_speed: -0.5\n");
+  EXPECT_TRUE(has(v, "section 'odometry'") && has(v, "moving_start_speed must be finite and >= 0")) << v;
+}
+
 TEST(OdometryConfigReader, AMissingFileIsAnErrorNamingIt) {
   test::TempDir dir;
   const std::string path = (dir / "absent.yaml").string();

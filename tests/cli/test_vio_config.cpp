@@ -61,6 +61,22 @@ TEST(VioConfigIo, AFileWithoutTheSectionGivesTheDefaults) {
   EXPECT_EQ(c.depth_mode, vio::DepthMode::kFixed);
 }
 
+TEST(VioConfigIo, ANegativeSeedThresholdOrNoObservationsIsAnErrorNamingTheValue) {
+  TempDir dir;
+  for (const auto& [yaml, words] : std::vector<std::pair<std::string, std::string>>{
+           {"vio:\n  seed_max_median_px: -1\n", "seed_max_median_px must be >= 0"},
+           {"vio:\n  seed_min_observations: 0\n", "seed_min_observations must be >= 1"}}) {
+    try {
+      io::loadVioConfig(write(dir, yaml));
+      ADD_FAILURE() << "accepted: " << yaml;
+    } catch (const io::IoError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find("platform.yaml"), std::string::npos) << what;
+      EXPECT_NE(what.find(words), std::string::npos) << what;
+    }
+  }
+}
+
 TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) {
   TempDir dir;
   for (const auto& [yaml, words] : std::vector<std::pair<std::string, std::string>>{
