@@ -33,10 +33,11 @@ VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method
   } catch (const std::invalid_argument& e) {
     // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is
     // relative to the working directory: a run must not fail for them. Shi-Tomasi is VINS-Mono's and LVI-SAM's own.
+    // Said at error level so that -q keeps it: a run that silently used another detector would be misread.
     if (visual.detector.type != visual::DetectorType::kSuperPoint) throw;
     const std::string what = e.what();
-    spdlog::warn("VIS: SuperPoint cannot start ({}): the VIS uses Shi-Tomasi instead (visual.detector.superpoint."
-                 "weights, or visual.detector.type)", what.substr(0, what.find(". ")));
+    spdlog::error("VIS: SuperPoint cannot start ({}): the VIS uses Shi-Tomasi instead (visual.detector.superpoint."
+                  "weights, or visual.detector.type); the run goes on", what.substr(0, what.find(". ")));
     visual::DetectorConfig fallback = visual.detector;
     fallback.type = visual::DetectorType::kShiTomasi;
     visual::paceDetection(fallback.type, setup.config.tracker);

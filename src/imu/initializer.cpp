@@ -16,6 +16,7 @@ struct WindowStats {
   Time first = 0, last = 0;
   bool all_oriented = true;
   Eigen::Vector4d q_sum = Eigen::Vector4d::Zero();  // sign-aligned quaternion coefficients (chordal mean)
+  Eigen::Vector4d q_first = Eigen::Vector4d::Zero();  // the window's first sample's orientation
 };
 
 bool finiteSample(const ImuSample& s) { return s.omega_imu.allFinite() && s.acc_imu.allFinite(); }
@@ -37,6 +38,7 @@ WindowStats windowStats(const std::vector<ImuSample>& samples, Time start) {
       continue;
     }
     const Eigen::Vector4d q = s.q_world_imu->normalized().coeffs();
+    if (w.count == 1) w.q_first = q;
     w.q_sum += (w.q_sum.dot(q) < 0 ? -q : q);  // q and -q are the same rotation
   }
   if (w.count == 0) return w;
@@ -118,14 +120,18 @@ StaticInitializer::Result StaticInitializer::initialize(const std::vector<ImuSam
   result.acc_std = w.acc_std;
   result.gravity_magnitude = w.mean_acc.norm();
   result.q_world_imu = attitudeFromGravity(w.mean_acc);
+  result.reason = staticFailures(w, config_);
+  result.is_static = result.reason.empty();
   if (config_.use_orientation && w.all_oriented && w.q_sum.norm() > 0) {
-    result.q_world_imu.coeffs() = w.q_sum.normalized();
+    // At rest the window's mean orientation averages the unit's noise. In motion the orientation turns through
+    // the window and its mean is the attitude of no instant: kitti05-replay's car, pitching and turning in its
+    // first second, got a start attitude 0.46 deg off in tilt that way, and the map inherited the slope (0.5 m
+    // of height in the first 50 m). The first sample's own orientation is the attitude at the window's start.
+    result.q_world_imu.coeffs() = result.is_static ? w.q_sum.normalized() : w.q_first;
     result.used_orientation = true;
     const Eigen::Vector3d up = result.q_world_imu * w.mean_acc.normalized();
     result.tilt_mismatch = std::acos(std::clamp(up.z(), -1.0, 1.0));
   }
-  result.reason = staticFailures(w, config_);
-  result.is_static = result.reason.empty();
   if (result.is_static) result.bias.gyro = w.mean_gyro;
   return result;
 }

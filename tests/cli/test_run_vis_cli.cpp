@@ -142,6 +142,30 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// SuperPoint's weights are a separate download: a run whose weights are missing goes on with Shi-Tomasi, and says so
+// even under -q (a run that quietly used another detector would be misread), and report.json names the detector.
+TEST(VisRun, MissingSuperPointWeightsFallBackToShiTomasiAndSayItEvenWhenQuiet) {
+  TempDir dir;
+  const CliResult sim = simulate(dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  std::ifstream in(std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string yaml = text.str();
+  const std::string from = "weights: ../shared/models/superpoint_v1.onnx";
+  const auto at = yaml.find(from);
+  ASSERT_NE(at, std::string::npos) << "farm_sim.yaml no longer names the shared weights";
+  yaml.replace(at, from.size(), "weights: no_such_weights.onnx");
+  writeText(dir / "missing_weights.yaml", yaml);
+  const CliResult r = runDrover("run " + (dir / "straight").string() + " --format sim --config " +
+                                (dir / "missing_weights.yaml").string() + " --no-lidar --no-loop -q --out " +
+                                (dir / "run").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("SuperPoint cannot start"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no_such_weights.onnx"), std::string::npos) << r.output;
+  EXPECT_EQ(readJson(dir / "run" / "report.json")["vis"]["detector"], "shi-tomasi (SuperPoint unavailable)");
+}
+
 TEST(VisRunRefuses, NoLidarWithNoCameraIsAnErrorBeforeAnyWork) {
   TempDir dir;
   const CliResult r = runDrover("run " + dir.path().string() + " --format sim --no-lidar --no-camera --out " +

@@ -3,6 +3,7 @@
 // dotted key. (In tests/cli because that test module links drover_io_visual.)
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "io/error.hpp"
@@ -227,6 +228,27 @@ TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
   e = errorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
   EXPECT_TRUE(has(e, "visual.depth")) << e;
   EXPECT_TRUE(has(e, "line 3")) << e;
+}
+
+TEST(VisualConfigReader, RelativeWeightsAreTheWorkingDirectorysElseTheOnesBesideTheConfig) {
+  test::TempDir dir;
+  test::writeText(dir / "own_superpoint.onnx", "not a network: only its place matters here");
+  const std::string beside = (dir / "own_superpoint.onnx").lexically_normal().string();
+  EXPECT_EQ(load(dir, "visual:\n  detector:\n    superpoint:\n      weights: own_superpoint.onnx\n")
+                .detector.superpoint.weights,
+            beside);
+  // Found nowhere: left as written, for the detector's error to name.
+  EXPECT_EQ(load(dir, "visual:\n  detector:\n    superpoint:\n      weights: no_such.onnx\n")
+                .detector.superpoint.weights,
+            "no_such.onnx");
+  // Found in the working directory: that one, as the shipped configs' paths are meant.
+  test::TempDir cwd_file;
+  const std::string there = (cwd_file / "w.onnx").string();
+  test::writeText(cwd_file / "w.onnx", "x");
+  const std::string relative = std::filesystem::relative(there).string();
+  EXPECT_EQ(load(dir, "visual:\n  detector:\n    superpoint:\n      weights: " + relative + "\n")
+                .detector.superpoint.weights,
+            relative);
 }
 
 TEST(VisualConfigReader, MissingFileIsAnIoError) {

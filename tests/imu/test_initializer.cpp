@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -83,6 +84,29 @@ TEST(StaticInitializer, MovingStartIsFlaggedNotStaticButStillGivesAnAttitude) {
   EXPECT_EQ(r.bias.gyro, Eigen::Vector3d::Zero());  // no bias is estimated while moving
   EXPECT_TRUE(r.q_world_imu.coeffs().allFinite());
   EXPECT_NEAR(r.q_world_imu.norm(), 1.0, 1e-12);
+}
+
+TEST(StaticInitializer, MovingStartTakesTheNineAxisAttitudeOfTheWindowsFirstSampleNotTheWindowsMean) {
+  // demandingPath turns ~0.6 rad/s in yaw and pitches through the window: its mean orientation is the attitude of
+  // no instant. The start state is placed at the window's first sample, so that sample's attitude is the answer.
+  const std::vector<ImuSample> imu = sim::simulateImu(demandingPath(), noisyUnit(true), 8);
+  const StaticInitializer::Result r = StaticInitializer().initialize(imu);
+  ASSERT_TRUE(r.ok) << r.reason;
+  ASSERT_FALSE(r.is_static);
+  EXPECT_TRUE(r.used_orientation);
+  const Time start = imu.back().t - fromSeconds(StaticInitializer::Config{}.window_s);
+  const auto first = std::find_if(imu.begin(), imu.end(), [&](const ImuSample& s) { return s.t >= start; });
+  ASSERT_NE(first, imu.end());
+  const Eigen::Matrix3d R_first = first->q_world_imu->toRotationMatrix();
+  EXPECT_LT(geometry::rotationAngle(r.q_world_imu.toRotationMatrix().transpose() * R_first), 1e-9);
+  // The window's mean, what a static start takes, is far from it here: the test can tell the two apart.
+  Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+  for (auto s = first; s != imu.end(); ++s) {
+    const Eigen::Vector4d q = s->q_world_imu->coeffs();
+    sum += sum.dot(q) < 0 ? -q : q;
+  }
+  const Eigen::Quaterniond mean(Eigen::Vector4d(sum.normalized()));
+  EXPECT_GT(geometry::rotationAngle(mean.toRotationMatrix().transpose() * R_first), 5 * kDeg);
 }
 
 TEST(StaticInitializer, SteadyTurnInPlaceIsFlaggedByItsMeanRate) {

@@ -100,6 +100,19 @@ visual::ClaheMode parseClahe(const std::string& name) {  // already checked by b
   return visual::ClaheMode::kWhenDark;
 }
 
+// A relative weights path is the working directory's (the shipped configs' ../shared/... is the repository root's).
+// Where nothing is there but the file sits beside the config, that is the one meant: a platform file kept with its
+// own weights then works from any working directory. Otherwise the path is left as written, for the detector's
+// error to name.
+std::string resolveBesideConfig(const std::string& yaml_path, const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path p(path);
+  if (path.empty() || p.is_absolute() || fs::exists(p, ec)) return path;
+  const fs::path beside = fs::path(yaml_path).parent_path() / p;
+  return fs::is_regular_file(beside, ec) ? beside.lexically_normal().string() : path;
+}
+
 }  // namespace
 
 VisualConfig loadVisualConfig(const std::string& yaml_path) {
@@ -116,6 +129,7 @@ VisualConfig loadVisualConfig(const std::string& yaml_path) {
   top.apply(visual);
   c.detector.type = visual::parseDetectorType(type);  // already checked by bindChoice
   c.tracker.clahe = parseClahe(clahe);
+  c.detector.superpoint.weights = resolveBesideConfig(yaml_path, c.detector.superpoint.weights);
   // Every detector's settings are checked, not only the chosen one's: a typo must not wait for a switch.
   const YAML::Node det = visual && visual.IsMap() ? visual["detector"] : YAML::Node();
   auto sub = [&](const char* key) { return det && det.IsMap() ? det[key] : YAML::Node(); };
