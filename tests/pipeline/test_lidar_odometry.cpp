@@ -13,41 +13,21 @@
 #include "pipeline/lidar_odometry.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
+#include "support/sharp_turns_course.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-struct Course {
-  std::vector<Measurement> stream;
-  Calibration calibration;
-  Trajectory truth;  // T_world_imu
-};
-
 // 16 s of the sharp-turns course (at rest for 2.5 s, 11 m straight, then turning at ~19 deg/s from 13.5 s), VLP-16
 // and IMU, no camera.
-const Course& course() {
-  static const Course c = [] {
-    sim::ScenarioOptions so;
-    so.duration_s = 16.0;
-    static const sim::Scenario scenario = sim::makeScenario("sharp-turns", so);
-    sim::SimulatorConfig config = sim::SimulatorConfig::defaults();
-    config.enable_camera = false;
-    const sim::Simulator simulator(scenario, config, 7);
-    Course out;
-    simulator.run([&](Measurement&& m) { out.stream.push_back(std::move(m)); });
-    out.calibration = simulator.calibration();
-    out.truth = simulator.groundTruth();
-    return out;
-  }();
+const test::SharpTurnsCourse& course() {
+  static const test::SharpTurnsCourse c = test::sharpTurnsCourse(16.0);
   return c;
 }
 
 OdometryConfig simConfig(bool imu) {
-  OdometryConfig c;
+  OdometryConfig c = test::sharpTurnsOdometryConfig();
   c.use_imu = imu;
-  c.layout.min_range = c.features.min_range = 0.8;
-  c.features.surf_leaf = 0.2f;
-  c.local_map.plane_leaf = 0.2;
   return c;
 }
 
@@ -55,8 +35,7 @@ OdometryConfig simConfig(bool imu) {
 // a test failure and the nearest later index when there is none.
 std::size_t truthIndex(Time t) {
   const Trajectory& truth = course().truth;
-  const auto it =
-      std::lower_bound(truth.begin(), truth.end(), t, [](const StampedPose& p, Time x) { return p.t < x; });
+  const auto it = test::truthFrom(truth, t);
   if (it == truth.end() || it->t != t) ADD_FAILURE() << "no ground truth at " << t;
   return std::min<std::size_t>(static_cast<std::size_t>(it - truth.begin()), truth.size() - 1);
 }

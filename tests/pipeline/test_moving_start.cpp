@@ -11,46 +11,23 @@
 #include <vector>
 
 #include "pipeline/lidar_odometry.hpp"
-#include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
+#include "support/sharp_turns_course.hpp"
 
 namespace drover::pipeline {
 namespace {
-
-struct Course {
-  std::vector<Measurement> stream;  // from kStart on: the vehicle is moving at the first sweep
-  Calibration calibration;
-  Trajectory truth;  // T_world_imu
-};
 
 constexpr double kStart = 6.0;  // [s] into the sharp-turns course: on its straight at ~1.2 m/s, 7.5 s before a turn
 
 // The straight of the sharp-turns course (at rest for 2.5 s, 11 m straight, a turn from 13.5 s), VLP-16 and IMU, no
 // camera; the measurements before kStart dropped.
-const Course& movingCourse() {
-  static const Course c = [] {
-    sim::ScenarioOptions so;
-    so.duration_s = 13.0;
-    static const sim::Scenario scenario = sim::makeScenario("sharp-turns", so);
-    sim::SimulatorConfig config = sim::SimulatorConfig::defaults();
-    config.enable_camera = false;
-    const sim::Simulator simulator(scenario, config, 7);
-    Course out;
-    simulator.run([&](Measurement&& m) {
-      if (measurementTime(m) >= fromSeconds(kStart)) out.stream.push_back(std::move(m));
-    });
-    out.calibration = simulator.calibration();
-    out.truth = simulator.groundTruth();
-    return out;
-  }();
+const test::SharpTurnsCourse& movingCourse() {
+  static const test::SharpTurnsCourse c = test::sharpTurnsCourse(13.0, kStart);
   return c;
 }
 
 OdometryConfig simConfig(int moving_start_restart) {
-  OdometryConfig c;
-  c.layout.min_range = c.features.min_range = 0.8;
-  c.features.surf_leaf = 0.2f;
-  c.local_map.plane_leaf = 0.2;
+  OdometryConfig c = test::sharpTurnsOdometryConfig();
   c.moving_start_restart = moving_start_restart;
   return c;
 }
@@ -58,8 +35,7 @@ OdometryConfig simConfig(int moving_start_restart) {
 // The truth's velocity at t [m/s] (central difference of its 200 Hz positions).
 Eigen::Vector3d truthVelocity(Time t) {
   const Trajectory& truth = movingCourse().truth;
-  const auto it =
-      std::lower_bound(truth.begin(), truth.end(), t, [](const StampedPose& p, Time x) { return p.t < x; });
+  const auto it = test::truthFrom(truth, t);
   const std::size_t i = std::clamp<std::size_t>(static_cast<std::size_t>(it - truth.begin()), 1, truth.size() - 2);
   return (truth[i + 1].T_world_body.translation() - truth[i - 1].T_world_body.translation()) /
          toSeconds(truth[i + 1].t - truth[i - 1].t);
@@ -75,8 +51,7 @@ struct StartRun {
 // The truth's pose at t (nearest 200 Hz sample).
 const Eigen::Isometry3d& truthAt(Time t) {
   const Trajectory& truth = movingCourse().truth;
-  const auto it =
-      std::lower_bound(truth.begin(), truth.end(), t, [](const StampedPose& p, Time x) { return p.t < x; });
+  const auto it = test::truthFrom(truth, t);
   return (it == truth.end() ? truth.back() : *it).T_world_body;
 }
 
@@ -127,14 +102,9 @@ TEST(MovingStart, AtTheSpeedTheLidarMeasuresTheSmootherRestartsAndKeepsVelocityA
 }
 
 TEST(MovingStart, AStartAtRestIsNotRestarted) {
-  sim::ScenarioOptions so;
-  so.duration_s = 2.0;  // the sharp-turns course is at rest for its first 2.5 s
-  const sim::Scenario scenario = sim::makeScenario("sharp-turns", so);
-  sim::SimulatorConfig config = sim::SimulatorConfig::defaults();
-  config.enable_camera = false;
-  const sim::Simulator simulator(scenario, config, 7);
-  LidarOdometry odometry(simConfig(OdometryConfig{}.moving_start_restart), simulator.calibration());
-  simulator.run([&](Measurement&& m) { odometry.process(m); });
+  const test::SharpTurnsCourse at_rest = test::sharpTurnsCourse(2.0);  // at rest for its first 2.5 s
+  LidarOdometry odometry(simConfig(OdometryConfig{}.moving_start_restart), at_rest.calibration);
+  for (const Measurement& m : at_rest.stream) odometry.process(m);
   odometry.finish();
   const std::string& note = odometry.stats().imu_init;
   EXPECT_NE(note.find("static start"), std::string::npos) << note;
