@@ -86,7 +86,6 @@ void runTrack(const TrackOptions& o) {
   if (!o.weights.empty()) detector_config.superpoint.weights = o.weights;
   visual::FeatureTrackerConfig tracker_config = visual_config.tracker;
   if (o.async) tracker_config.async_detection = true;
-  visual::paceDetection(detector_config.type, tracker_config);
   const visual::CameraModel camera(reader->calibration().camera);
   visual::FeatureTracker tracker(camera, visual::makeDetector(detector_config), tracker_config);
 

@@ -24,7 +24,6 @@ VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method
   VisSetup setup;
   setup.config.vio = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
   method.apply(visual, setup.config.vio);
-  visual::paceDetection(visual.detector.type, visual.tracker);  // after the preset: it may change the detector
   setup.config.tracker = visual.tracker;
   setup.config.depth = visual.depth;
   setup.detector_name = visual::detectorTypeName(visual.detector.type);
@@ -40,7 +39,6 @@ VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method
                   "weights, or visual.detector.type); the run goes on", what.substr(0, what.find(". ")));
     visual::DetectorConfig fallback = visual.detector;
     fallback.type = visual::DetectorType::kShiTomasi;
-    visual::paceDetection(fallback.type, setup.config.tracker);
     setup.detector = visual::makeDetector(fallback);
     setup.detector_name = "shi-tomasi (SuperPoint unavailable)";
   }

@@ -47,10 +47,4 @@ std::unique_ptr<KeypointDetector> makeDetector(const DetectorConfig& config) {
   throw std::invalid_argument("unknown detector type");
 }
 
-void paceDetection(DetectorType type, FeatureTrackerConfig& tracker) {
-  if (type == DetectorType::kSuperPoint) return;
-  tracker.detect_interval_s = 0;
-  tracker.detect_urgent_below = 0;
-}
-
 }  // namespace drover::visual

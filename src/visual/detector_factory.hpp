@@ -29,10 +29,4 @@ struct DetectorConfig {
 // Throws std::invalid_argument on an invalid config, and (SuperPoint) on missing or malformed weights.
 std::unique_ptr<KeypointDetector> makeDetector(const DetectorConfig& config);
 
-// The tracker's detection pacing (detect_interval_s, detect_urgent_below) bounds a slow detector: SuperPoint, ~0.1-0.4
-// s a pass here. Shi-Tomasi and ORB cost milliseconds and detect whenever the tracks need it (VINS-Mono), so for them
-// the pacing is switched off. Call wherever the detector is chosen or changed (presets, --detector, a fall-back):
-// paced Shi-Tomasi starved the lvi-sam preset's VIS on the farm course (20 m APE instead of 0.35 m).
-void paceDetection(DetectorType type, FeatureTrackerConfig& tracker);
-
 }  // namespace drover::visual

@@ -51,8 +51,8 @@ struct FeatureTrackerConfig {
                                     // below max_features, as VINS-Mono); the VIS's policy for a slow detector
   // A slow detector that finds fewer features than detect_below (SuperPoint on plain walls) would otherwise run at
   // every frame: after a detection the next one waits detect_interval_s of image time, unless the live tracks fall
-  // below detect_urgent_below. 0 = no wait. visual::paceDetection (detector_factory.hpp) turns it off for the
-  // millisecond detectors where the detector is chosen.
+  // below detect_urgent_below. 0 = no wait. Only a detector that says it is paced (KeypointDetector::paced:
+  // SuperPoint) is held; the millisecond ones ignore these two keys.
   double detect_interval_s = 0;     // [s]
   int detect_urgent_below = 0;      // [tracks]
   std::string validate() const;     // empty = valid, else names the bad value

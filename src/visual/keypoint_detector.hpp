@@ -25,6 +25,11 @@ class KeypointDetector {
   // (naming what was wrong: size, type, emptiness).
   virtual Keypoints detect(const cv::Mat& image, const cv::Mat& mask, int max_count) = 0;
   virtual std::string name() const = 0;  // "superpoint", "shi-tomasi", "orb"
+  // True for a detector whose pass costs about a frame's time or more (SuperPoint, ~0.1-0.4 s on these cores): the
+  // tracker's detection pacing (FeatureTrackerConfig::detect_interval_s, detect_urgent_below) holds only such a
+  // detector. Millisecond detectors (Shi-Tomasi, ORB) detect whenever the tracks need it, as VINS-Mono: a paced
+  // Shi-Tomasi starved the lvi-sam preset's VIS on the farm course (20 m APE instead of 0.35 m).
+  virtual bool paced() const { return false; }
 };
 
 }  // namespace drover::visual

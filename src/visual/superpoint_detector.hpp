@@ -39,6 +39,7 @@ class SuperPointDetector : public KeypointDetector {
   // descriptors CV_32F, 256 per row, unit L2 norm.
   Keypoints detect(const cv::Mat& image, const cv::Mat& mask, int max_count) override;
   std::string name() const override { return "superpoint"; }
+  bool paced() const override { return true; }
   const SuperPointConfig& config() const { return config_; }
 
   // The network input size used for an image of this size [px].

@@ -42,7 +42,6 @@ FusedRun runFused(const test::LiveCourse& course, Time until = 0, bool factor = 
   vis_config.depth = visual.depth;
   visual::DetectorConfig detector = visual.detector;
   detector.type = visual::DetectorType::kShiTomasi;  // SuperPoint costs ~0.4 s a frame here
-  visual::paceDetection(detector.type, vis_config.tracker);
   vio::VisualOdometry vo(vis_config, course.calibration, odometry_config.preintegration, visual::makeDetector(detector));
   lis.setSweepListener([&](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
     vo.addSweep(t, T, p);

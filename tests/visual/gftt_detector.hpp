@@ -28,6 +28,8 @@ class GfttDetector : public KeypointDetector {
     return k;
   }
   std::string name() const override { return "test-gftt"; }
+  bool paced() const override { return slow; }
+  bool slow = false;  // stands for a slow detector (SuperPoint) in the pacing tests; set before tracking
   std::atomic<int> calls = 0;
   std::mutex mutex;
   std::vector<std::pair<cv::Mat, std::vector<cv::Point2f>>> history;  // (image, points) of every call

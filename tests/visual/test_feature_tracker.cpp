@@ -287,6 +287,7 @@ TEST(FeatureTracker, DetectIntervalHoldsASlowDetectorToOneRunPerIntervalUnlessTr
   config.detect_interval_s = 0.2;  // 4 frames at 20 Hz
   config.detect_urgent_below = 30;
   const auto detector = std::make_shared<GfttDetector>();
+  detector->slow = true;
   FeatureTracker tracker(pinhole(), detector, config);
   std::vector<int> ran;
   for (int i = 0; i < 30; ++i) {
@@ -303,6 +304,11 @@ TEST(FeatureTracker, DetectIntervalHoldsASlowDetectorToOneRunPerIntervalUnlessTr
   FeatureTracker without(pinhole(), plain, every);
   for (int i = 0; i < 30; ++i) without.track(i * kFrameNs, testing::view(canvas, {12.0 * i, 0}, kSize));
   EXPECT_EQ(plain->calls, 30) << "without the interval the detector runs at every frame here";
+  // A millisecond detector ignores the pacing: the same interval config, a detector that is not paced.
+  const auto fast = std::make_shared<GfttDetector>();
+  FeatureTracker unpaced(pinhole(), fast, config);
+  for (int i = 0; i < 30; ++i) unpaced.track(i * kFrameNs, testing::view(canvas, {12.0 * i, 0}, kSize));
+  EXPECT_EQ(fast->calls, 30) << "the pacing holds only a paced detector";
 }
 
 TEST(FeatureTracker, RejectsBadConfigImagesAndTimes) {

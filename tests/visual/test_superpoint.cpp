@@ -40,6 +40,13 @@ TEST(SuperPointDetector, MatchesTheNumpyReferenceOnARandomSuperPointNetwork) {
   }
 }
 
+// Its passes cost ~0.1-0.4 s here: the tracker's detection pacing applies to it (KeypointDetector::paced).
+TEST(SuperPointDetector, IsPaced) {
+  TempDir dir;
+  DROVER_MAKE_SUPERPOINT_ONNX(dir.path(), "ok");
+  EXPECT_TRUE(SuperPointDetector(configFor(dir / "model.onnx")).paced());
+}
+
 TEST(SuperPointDetector, MaxCountKeepsTheStrongestPrefixAndConfigCapsIt) {
   TempDir dir;
   DROVER_MAKE_SUPERPOINT_ONNX(dir.path(), "ok");
