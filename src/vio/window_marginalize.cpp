@@ -39,10 +39,10 @@ void SlidingWindowEstimator::declareWindowBlocks(backend::SchurMarginalizer& m) 
 }
 
 SlidingWindowEstimator::Residuals SlidingWindowEstimator::declareWindow(backend::SchurMarginalizer& m,
-                                                                      bool oldest_only) {
+                                                                      bool for_marginalization_of_oldest) {
   declareWindowBlocks(m);
   Residuals r;
-  buildResiduals(r, oldest_only);
+  buildResiduals(r, for_marginalization_of_oldest);
   for (double* d : r.inverse_depths) m.addBlock(d, 1, nullptr);
   return r;
 }
