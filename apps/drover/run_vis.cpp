@@ -17,6 +17,16 @@ using Json = nlohmann::json;
 constexpr std::size_t kMaxEvents = 200;  // report.json keeps the first events; the counters count them all
 constexpr std::size_t kShownResets = 20;  // reset warnings printed; the rest are counted
 
+// A warning that -q (errors only) keeps: a run that quietly used another detector than the one asked for would be
+// misread, and an [error] line would say the run failed (the CLI's contract), which it did not. Called at set-up,
+// before any thread logs.
+void warnEvenWhenQuiet(const std::string& message) {
+  const spdlog::level::level_enum level = spdlog::get_level();
+  if (level > spdlog::level::warn) spdlog::set_level(spdlog::level::warn);
+  spdlog::warn("{}", message);
+  spdlog::set_level(level);
+}
+
 }  // namespace
 
 VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method) {
@@ -32,11 +42,10 @@ VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method
   } catch (const std::invalid_argument& e) {
     // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is
     // relative to the working directory: a run must not fail for them. Shi-Tomasi is VINS-Mono's and LVI-SAM's own.
-    // Said at error level so that -q keeps it: a run that silently used another detector would be misread.
     if (visual.detector.type != visual::DetectorType::kSuperPoint) throw;
     const std::string what = e.what();
-    spdlog::error("VIS: SuperPoint cannot start ({}): the VIS uses Shi-Tomasi instead (visual.detector.superpoint."
-                  "weights, or visual.detector.type); the run goes on", what.substr(0, what.find(". ")));
+    warnEvenWhenQuiet(fmt::format("VIS: SuperPoint cannot start ({}): the VIS uses Shi-Tomasi instead (visual.detector."
+                                  "superpoint.weights, or visual.detector.type)", what.substr(0, what.find(". "))));
     visual::DetectorConfig fallback = visual.detector;
     fallback.type = visual::DetectorType::kShiTomasi;
     setup.detector = visual::makeDetector(fallback);
