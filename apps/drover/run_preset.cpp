@@ -43,7 +43,8 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
     odometry.degenerate_pose_from_match = false;
     f.factor = f.initial_guess = true;
     f.reset_after = pipeline::VisualMotionConfig{}.reset_after;
-    loop.source = pipeline::LoopSource::kScanContext;
+    // Scan Context, with the radius search beside it when the platform file asks for both.
+    if (loop.source != pipeline::LoopSource::kBoth) loop.source = pipeline::LoopSource::kScanContext;
     loop.yaw_prior = loop.visual_yaw_prior = true;
   } else if (preset == Preset::kLviSam) {
     f.factor = false;
