@@ -142,6 +142,33 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
+// The drover preset's loop closure is Scan Context; a platform file that asks for Scan Context and the radius search
+// together keeps both (the radius search adds the nearby loops of a course that drifts little), one that asks for
+// the radius search alone gets Scan Context.
+TEST(VisRun, PresetDroverKeepsBothLoopSourcesWhenThePlatformFileAsksForThem) {
+  TempDir dir;
+  const CliResult sim = simulate(dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  std::ifstream in(shiTomasiConfig("farm_sim.yaml", dir.path()));
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string yaml = text.str();
+  const std::string from = "source: scancontext";
+  const auto at = yaml.find(from);
+  ASSERT_NE(at, std::string::npos) << "farm_sim.yaml no longer names its loop source";
+  for (const std::string source : {"both", "radius"}) {
+    SCOPED_TRACE(source);
+    std::string changed = yaml;
+    changed.replace(at, from.size(), "source: " + source);
+    writeText(dir / (source + ".yaml"), changed);
+    const CliResult r = runDrover("run " + (dir / "straight").string() + " --format sim --config " +
+                                  (dir / (source + ".yaml")).string() + " --no-camera -q --preset drover --out " +
+                                  (dir / source).string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(readJson(dir / source / "report.json")["loops"]["source"], source == "both" ? "both" : "scancontext");
+  }
+}
+
 // SuperPoint's weights are a separate download: a run whose weights are missing goes on with Shi-Tomasi, and says so
 // even under -q (a run that quietly used another detector would be misread), and report.json names the detector.
 TEST(VisRun, MissingSuperPointWeightsFallBackToShiTomasiAndSayItEvenWhenQuiet) {
