@@ -20,13 +20,13 @@ namespace {
 
 // 16 s of the sharp-turns course (at rest for 2.5 s, 11 m straight, then turning at ~19 deg/s from 13.5 s), VLP-16
 // and IMU, no camera.
-const test::SharpTurnsCourse& course() {
-  static const test::SharpTurnsCourse c = test::sharpTurnsCourse(16.0);
+const test::LiveCourse& course() {
+  static const test::LiveCourse c = test::sharpTurnsCourse(16.0);
   return c;
 }
 
 OdometryConfig simConfig(bool imu) {
-  OdometryConfig c = test::sharpTurnsOdometryConfig();
+  OdometryConfig c = test::simOdometryConfig();
   c.use_imu = imu;
   return c;
 }

@@ -21,13 +21,13 @@ constexpr double kStart = 6.0;  // [s] into the sharp-turns course: on its strai
 
 // The straight of the sharp-turns course (at rest for 2.5 s, 11 m straight, a turn from 13.5 s), VLP-16 and IMU, no
 // camera; the measurements before kStart dropped.
-const test::SharpTurnsCourse& movingCourse() {
-  static const test::SharpTurnsCourse c = test::sharpTurnsCourse(13.0, kStart);
+const test::LiveCourse& movingCourse() {
+  static const test::LiveCourse c = test::sharpTurnsCourse(13.0, kStart);
   return c;
 }
 
 OdometryConfig simConfig(int moving_start_restart) {
-  OdometryConfig c = test::sharpTurnsOdometryConfig();
+  OdometryConfig c = test::simOdometryConfig();
   c.moving_start_restart = moving_start_restart;
   return c;
 }
@@ -102,7 +102,7 @@ TEST(MovingStart, AtTheSpeedTheLidarMeasuresTheSmootherRestartsAndKeepsVelocityA
 }
 
 TEST(MovingStart, AStartAtRestIsNotRestarted) {
-  const test::SharpTurnsCourse at_rest = test::sharpTurnsCourse(2.0);  // at rest for its first 2.5 s
+  const test::LiveCourse at_rest = test::sharpTurnsCourse(2.0);  // at rest for its first 2.5 s
   LidarOdometry odometry(simConfig(OdometryConfig{}.moving_start_restart), at_rest.calibration);
   for (const Measurement& m : at_rest.stream) odometry.process(m);
   odometry.finish();
