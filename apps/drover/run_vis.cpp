@@ -40,8 +40,9 @@ VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method
   try {
     setup.detector = visual::makeDetector(visual.detector);
   } catch (const std::invalid_argument& e) {
-    // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is
-    // relative to the working directory: a run must not fail for them. Shi-Tomasi is VINS-Mono's and LVI-SAM's own.
+    // SuperPoint's weights are a separate download (non-commercial licence) and a relative path in a config is the
+    // working directory's (else the one beside the config file): a run must not fail for them. Shi-Tomasi is
+    // VINS-Mono's and LVI-SAM's own.
     if (visual.detector.type != visual::DetectorType::kSuperPoint) throw;
     const std::string what = e.what();
     warnEvenWhenQuiet(fmt::format("VIS: SuperPoint cannot start ({}): the VIS uses Shi-Tomasi instead (visual.detector."

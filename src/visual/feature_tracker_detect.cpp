@@ -104,8 +104,9 @@ void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
   // Detect-when-needed: a slow detector (SuperPoint) runs only when the live tracks fall below detect_below.
   const int live = static_cast<int>(tracks_.size());
   const bool enough = config_.detect_below > 0 && live >= config_.detect_below;
-  const bool waiting = detector_->paced() && config_.detect_interval_s > 0 && live > 0 && live >= config_.detect_urgent_below &&
-                       last_detection_t_ && toSeconds(result.t - *last_detection_t_) < config_.detect_interval_s;
+  const bool waiting = detector_->paced() && config_.detect_interval_s > 0 && live > 0 &&
+                       live >= config_.detect_urgent_below && last_detection_t_ &&
+                       toSeconds(result.t - *last_detection_t_) < config_.detect_interval_s;
   if ((enough || waiting) && !(config_.async_detection && job_.valid())) return;
   if (!config_.async_detection || tracks_.size() == 0) {
     if (config_.async_detection && job_.valid()) job_.wait();  // the detector serves one caller at a time

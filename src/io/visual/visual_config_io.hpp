@@ -7,8 +7,8 @@
 //       shi_tomasi:   max_cnt, min_dist [px], quality_level, block_size [px]  (visual/shi_tomasi_detector.hpp)
 //       orb:          n_features, scale_factor, n_levels, fast_threshold [grey levels], edge_threshold [px]
 //       superpoint:   weights (ONNX file; relative = to the working directory, else beside the config file),
-//                     input_width, input_height [px], max_keypoints, confidence_threshold, nms_radius [px], border [px], threads,
-//                     min_keypoints (floor below the threshold; 0 = off)
+//                     input_width, input_height [px], max_keypoints, confidence_threshold, nms_radius [px],
+//                     border [px], threads, min_keypoints (floor below the threshold; 0 = off)
 //     tracker:        max_features, min_distance [px], flow_window [px], flow_levels, flow_iterations,
 //                     flow_epsilon [px], forward_backward (bool), forward_backward_px [px], border_px [px],
 //                     ransac (bool), ransac_threshold_px [px at virtual_focal_px], ransac_confidence,
