@@ -7,6 +7,7 @@
 
 #include "io/error.hpp"
 #include "io/visual/vio_config_io.hpp"
+#include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::test {
@@ -66,14 +67,9 @@ TEST(VioConfigIo, ANegativeSeedThresholdOrNoObservationsIsAnErrorNamingTheValue)
   for (const auto& [yaml, words] : std::vector<std::pair<std::string, std::string>>{
            {"vio:\n  seed_max_median_px: -1\n", "seed_max_median_px must be >= 0"},
            {"vio:\n  seed_min_observations: 0\n", "seed_min_observations must be >= 1"}}) {
-    try {
-      io::loadVioConfig(write(dir, yaml));
-      ADD_FAILURE() << "accepted: " << yaml;
-    } catch (const io::IoError& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("platform.yaml"), std::string::npos) << what;
-      EXPECT_NE(what.find(words), std::string::npos) << what;
-    }
+    SCOPED_TRACE(yaml);
+    const std::string path = write(dir, yaml);
+    test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", words});
   }
 }
 
@@ -86,15 +82,9 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  sigma_px: -1\n", "sigma_px must be > 0"},
            {"vio:\n  max_time_offset_s: nan\n", "vio.max_time_offset_s"},
            {"vio:\n  relative_covariance: often\n", "vio.relative_covariance"}}) {
-    try {
-      io::loadVioConfig(write(dir, yaml));
-      ADD_FAILURE() << "accepted: " << yaml;
-    } catch (const io::IoError& e) {
-      const std::string what = e.what();
-      EXPECT_NE(what.find("platform.yaml"), std::string::npos) << what;
-      EXPECT_NE(what.find("line"), std::string::npos) << what;
-      EXPECT_NE(what.find(words), std::string::npos) << what;
-    }
+    SCOPED_TRACE(yaml);
+    const std::string path = write(dir, yaml);
+    test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", "line", words});
   }
 }
 
