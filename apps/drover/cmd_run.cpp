@@ -359,12 +359,12 @@ void registerRun(CLI::App& app) {
   cmd->add_option("--preset", o->preset,
                   "Methods of the paper's comparison over the platform config (which still sets the sensors): "
                   "drover (SuperPoint, lidar depth factors, the VIS's motion as a factor, Scan Context with the VIS's "
-                  "yaw) or lvi-sam (Shi-Tomasi, fixed lidar depth, the VIS's motion as the guess only, radius loops); "
+                  "yaw beside the radius search, a 4-DoF pose graph) or lvi-sam (Shi-Tomasi, fixed lidar depth, the VIS's motion as the guess only, radius loops); "
                   "default: the platform config's own choices")
       ->check(CLI::IsMember(presetNames()));
   cmd->add_option("--without", o->without,
                   "Take a part out after the preset (repeatable; the ablation): vo-factor, vis-guess, vis-gates, "
-                  "visual-yaw-prior, scan-context, depth-factor, superpoint")
+                  "visual-yaw-prior, scan-context, radius-search, four-dof, depth-factor, superpoint")
       ->check(CLI::IsMember(partNames()));
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");

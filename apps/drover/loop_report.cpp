@@ -7,6 +7,9 @@
 #include <numbers>
 #include <optional>
 
+#include "geometry/se3.hpp"
+#include "geometry/so3.hpp"
+
 namespace drover::cli {
 namespace {
 
@@ -55,6 +58,8 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
          {"inliers", v.inliers},
          {"inlier_ratio", v.inlier_ratio},
          {"correction_from_guess_m", v.correction_translation},
+         {"sigma_position_m", std::sqrt(v.covariance.topLeftCorner<3, 3>().trace() / 3)},
+         {"sigma_rotation_deg", std::sqrt(v.covariance.bottomRightCorner<3, 3>().trace() / 3) * kDeg},
          {"graph_ms", e.graph_ms},
          {"graph_iterations", e.graph_iterations},
          {"graph_initial_cost", e.graph_initial_cost},
@@ -71,6 +76,12 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
     const Eigen::Isometry3d err = T_true.inverse() * v.T_candidate_query;
     const double et = err.translation().norm(), er = Eigen::AngleAxisd(err.linear()).angle() * kDeg;
     correct = et < kCorrectTranslation && er < kCorrectRotation;
+    // The error normalised by the loop factor's own covariance (NEES, 6 DoF, decoupled [dp; dphi] as the graph
+    // takes it): about 6 on average when the verifier's covariance is honest.
+    geometry::Vector6d d;
+    d << err.translation(), geometry::logSO3(err.linear());
+    d.head<3>() = T_true.linear() * d.head<3>();
+    j["nees"] = d.dot(v.information * d);
     j["true_distance_m"] = T_true.translation().norm();
     j["pose_error_m"] = et;
     j["pose_error_deg"] = er;
@@ -110,6 +121,7 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
   const TruthLookup truth(c);
   Json j{{"enabled", loops.config().enabled},
          {"source", pipeline::toString(loops.config().source)},
+         {"graph_dof", loops.config().graph.yaw_only_rotation ? 4 : 6},  // 4: x, y, z, yaw (roll, pitch kept)
          {"queries", s.queries},
          {"candidates", s.candidates},
          {"verified", s.verified},

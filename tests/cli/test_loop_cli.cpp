@@ -155,5 +155,34 @@ TEST(LoopEvalCli, CourseModeOnASimulatedOverlapFindsRevisitsWithoutFalsePositive
   }
 }
 
+// Each accepted loop in report.json says how sure the verifier claims to be (the factor's sigmas) and, with ground
+// truth, how far off it was in those sigmas (NEES over 6 DoF; about 6 on average when the claim is honest). With the
+// verifier's floors dominating, the NEES is the pose error over the reported sigmas, squared and summed.
+TEST(LoopRunReport, EveryAcceptedLoopCarriesItsClaimedSigmasAndItsErrorNormalisedByThem) {
+  TempDir tmp;
+  const fs::path sim = tmp / "overlap";
+  const CliResult g = runDrover("sim -q --scenario overlap --no-camera --duration 0 --out " + sim.string());
+  ASSERT_EQ(g.exit_code, 0) << g.output;
+  const CliResult r = runDrover("run -q " + sim.string() + " --format sim --config " + kSimConfig +
+                                " --no-camera --out " + (tmp / "run").string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const Json loops = readJson(tmp / "run" / "report.json")["loops"];
+  int accepted = 0;
+  double nees_sum = 0;
+  for (const Json& e : loops["events"]) {
+    if (!e["accepted"].get<bool>()) continue;
+    ++accepted;
+    const double sp = e["sigma_position_m"], sr = e["sigma_rotation_deg"];
+    EXPECT_GE(sp, 0.05) << "the verifier's position floor";
+    EXPECT_GE(sr, 0.005 * 180 / M_PI) << "the verifier's rotation floor";
+    const double et = e["pose_error_m"], er = e["pose_error_deg"], nees = e["nees"];
+    const double expected = (et / sp) * (et / sp) + (er / sr) * (er / sr);
+    EXPECT_NEAR(nees, expected, 0.1 * expected + 0.01) << "loop at " << e["t_query"];
+    nees_sum += nees;
+  }
+  ASSERT_GE(accepted, 3) << "the overlap course closes loops";
+  EXPECT_LT(nees_sum / accepted, 6.0) << "on a clean course the verifier's sigmas are not overconfident";
+}
+
 }  // namespace
 }  // namespace drover::test

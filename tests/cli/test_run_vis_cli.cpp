@@ -122,6 +122,7 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   const Json r = readJson(dir / "lvi" / "report.json");
   EXPECT_EQ(r["preset"], "lvi-sam");
   EXPECT_EQ(r["loops"]["source"], "radius");
+  EXPECT_EQ(r["loops"]["graph_dof"], 6) << "LIO-SAM's keyframe graph corrects all six degrees of freedom";
   EXPECT_EQ(r["vis"]["depth_mode"], "fixed");
   EXPECT_EQ(r["vis"]["detector"], "shi-tomasi");
   EXPECT_EQ(r["counts"]["vis_factor_scans"], 0) << "LVI-SAM's released code has no visual odometry factor";
@@ -133,6 +134,7 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_EQ(n["preset"], "drover without superpoint, vo-factor");
   EXPECT_EQ(n["vis"]["depth_mode"], "factor");
   EXPECT_EQ(n["counts"]["vis_factor_scans"], 0);
+  EXPECT_EQ(n["loops"]["graph_dof"], 4) << "the drover preset's pose graph leaves roll and pitch to the IMU";
   const CliResult bad = runDrover(base + " --preset vins --out " + (dir / "bad").string());
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("--preset"), std::string::npos) << bad.output;
@@ -142,10 +144,10 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_FALSE(fs::exists(dir / "bad"));
 }
 
-// The drover preset's loop closure is Scan Context; a platform file that asks for Scan Context and the radius search
-// together keeps both (the radius search adds the nearby loops of a course that drifts little), one that asks for
-// the radius search alone gets Scan Context.
-TEST(VisRun, PresetDroverKeepsBothLoopSourcesWhenThePlatformFileAsksForThem) {
+// The drover preset searches both loop sources (Scan Context and the 15 m radius search) whatever the platform file
+// names, in a 4-DoF graph; --without radius-search leaves Scan Context alone, --without scan-context the radius
+// search alone, --without four-dof the 6-DoF graph.
+TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTakesEachOut) {
   TempDir dir;
   const CliResult sim = simulate(dir);
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
@@ -156,16 +158,27 @@ TEST(VisRun, PresetDroverKeepsBothLoopSourcesWhenThePlatformFileAsksForThem) {
   const std::string from = "source: scancontext";
   const auto at = yaml.find(from);
   ASSERT_NE(at, std::string::npos) << "farm_sim.yaml no longer names its loop source";
-  for (const std::string source : {"both", "radius"}) {
-    SCOPED_TRACE(source);
-    std::string changed = yaml;
-    changed.replace(at, from.size(), "source: " + source);
-    writeText(dir / (source + ".yaml"), changed);
-    const CliResult r = runDrover("run " + (dir / "straight").string() + " --format sim --config " +
-                                  (dir / (source + ".yaml")).string() + " --no-camera -q --preset drover --out " +
-                                  (dir / source).string());
+  std::string radius_yaml = yaml;
+  radius_yaml.replace(at, from.size(), "source: radius");
+  writeText(dir / "radius.yaml", radius_yaml);
+  struct Case {
+    std::string name, config, without, source;
+    int dof;
+  };
+  const std::vector<Case> cases = {
+      {"sc_file", shiTomasiConfig("farm_sim.yaml", dir.path()), "", "both", 4},
+      {"radius_file", (dir / "radius.yaml").string(), "", "both", 4},
+      {"no_radius", (dir / "radius.yaml").string(), "--without radius-search", "scancontext", 4},
+      {"no_sc", (dir / "radius.yaml").string(), "--without scan-context", "radius", 4},
+      {"six_dof", (dir / "radius.yaml").string(), "--without four-dof", "both", 6}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const CliResult r = runDrover("run " + (dir / "straight").string() + " --format sim --config " + c.config +
+                                  " --no-camera -q --preset drover " + c.without + " --out " + (dir / c.name).string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_EQ(readJson(dir / source / "report.json")["loops"]["source"], source == "both" ? "both" : "scancontext");
+    const Json loops = readJson(dir / c.name / "report.json")["loops"];
+    EXPECT_EQ(loops["source"], c.source);
+    EXPECT_EQ(loops["graph_dof"], c.dof);
   }
 }
 
