@@ -359,7 +359,8 @@ void registerRun(CLI::App& app) {
   cmd->add_option("--preset", o->preset,
                   "Methods of the paper's comparison over the platform config (which still sets the sensors): "
                   "drover (SuperPoint, lidar depth factors, the VIS's motion as a factor, Scan Context with the VIS's "
-                  "yaw beside the radius search, a 4-DoF pose graph) or lvi-sam (Shi-Tomasi, fixed lidar depth, the VIS's motion as the guess only, radius loops); "
+                  "yaw beside the radius search, a 4-DoF pose graph) or lvi-sam (Shi-Tomasi, fixed lidar depth, the VIS's "
+                  "motion as the guess only, radius loops, a 6-DoF pose graph); "
                   "default: the platform config's own choices")
       ->check(CLI::IsMember(presetNames()));
   cmd->add_option("--without", o->without,
