@@ -122,6 +122,7 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
   Json j{{"enabled", loops.config().enabled},
          {"source", pipeline::toString(loops.config().source)},
          {"graph_dof", loops.config().graph.yaw_only_rotation ? 4 : 6},  // 4: x, y, z, yaw (roll, pitch kept)
+         {"radius_m", loops.config().radius},  // the radius search's reach (radius and both sources)
          {"queries", s.queries},
          {"candidates", s.candidates},
          {"verified", s.verified},

@@ -179,6 +179,7 @@ TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTak
     const Json loops = readJson(dir / c.name / "report.json")["loops"];
     EXPECT_EQ(loops["source"], c.source);
     EXPECT_EQ(loops["graph_dof"], c.dof);
+    EXPECT_EQ(loops["radius_m"], 15.0) << "LIO-SAM's historyKeyframeSearchRadius (Drover's own default is 10 m)";
   }
 }
 
