@@ -79,8 +79,7 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
     // The error normalised by the loop factor's own covariance (NEES, 6 DoF, decoupled [dp; dphi] as the graph
     // takes it): about 6 on average when the verifier's covariance is honest.
     geometry::Vector6d d;
-    d << err.translation(), geometry::logSO3(err.linear());
-    d.head<3>() = T_true.linear() * d.head<3>();
+    d << v.T_candidate_query.translation() - T_true.translation(), geometry::logSO3(err.linear());
     j["nees"] = d.dot(v.information * d);
     j["true_distance_m"] = T_true.translation().norm();
     j["pose_error_m"] = et;

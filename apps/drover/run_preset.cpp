@@ -101,9 +101,9 @@ void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
   if (part == "vis-guess") odometry.vis_fusion.initial_guess = false;
   if (part == "vis-gates") withoutGates(odometry.vis_fusion);
   if (part == "visual-yaw-prior") odometry.loop.visual_yaw_prior = false;
-  if (part == "four-dof") odometry.loop.four_dof_with_imu = false;
   if (part == "scan-context") odometry.loop.source = pipeline::LoopSource::kRadius;
   if (part == "radius-search") odometry.loop.source = pipeline::LoopSource::kScanContext;
+  if (part == "four-dof") odometry.loop.four_dof_with_imu = false;
 }
 
 void removePart(const std::string& part, io::VisualConfig& visual, vio::VioConfig& vio) {
