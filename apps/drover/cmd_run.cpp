@@ -14,6 +14,7 @@
 
 #include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
+#include "apps/drover/heap_tuning.hpp"
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
 #include "apps/drover/run_preset.hpp"
@@ -292,9 +293,11 @@ void runOdometry(const RunOptions& o) {
     }
     return *vis;
   };
+  HeapTrimmer heap;  // an hour-long replay returns its fragmented free pages every 30 s of data
   while (std::optional<Measurement> m = stop.requested() ? std::nullopt : ahead.next(onRead)) {
     showReaderDrops();
     const Time t = measurementTime(*m);
+    heap.tick(t);
     if (!t_first) t_first = t;
     const double since = toSeconds(t - *t_first);
     scans_read += std::holds_alternative<LidarScan>(*m) ? 1 : 0;

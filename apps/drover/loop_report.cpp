@@ -168,6 +168,8 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
     spdlog::info("loops: {} accepted of {} verified", s.accepted, s.verified);
   }
   j["events"] = events;
+  // Verified candidates older than the newest loop.max_events, left out of the list (and of precision and recall).
+  j["events_dropped"] = loops.eventsDropped();
   return j;
 }
 

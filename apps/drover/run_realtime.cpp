@@ -14,6 +14,8 @@
 #include <thread>
 #include <vector>
 
+#include "apps/drover/heap_tuning.hpp"
+
 namespace drover::cli {
 namespace {
 
@@ -151,6 +153,7 @@ void runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const
   std::optional<Time> t_first, data_zero;
   Clock::time_point wall_zero;
   double late_ms_max = 0;
+  HeapTrimmer heap;  // as the replay: the free pages returned every 30 s of data (apps/drover/heap_tuning.hpp)
   const auto pushDue = [&](Time up_to) {
     while (!held.empty() && held.top().first <= up_to) {
       const auto [arrival, id] = held.top();
@@ -165,6 +168,7 @@ void runRealtime(io::Reader& reader, const pipeline::SystemConfig& config, const
       const Clock::time_point due = wall_zero + since;
       std::this_thread::sleep_until(due);
       late_ms_max = std::max(late_ms_max, msBetween(due, Clock::now()));
+      heap.tick(arrival);
       if (auto* imu = std::get_if<ImuSample>(&m)) {
         lat.imu_arrival = due;
         system.pushImu(*imu);

@@ -16,6 +16,8 @@ std::string LoopVerifierConfig::validate() const {
   for (double v : positive)
     if (!std::isfinite(v) || v <= 0) return "max_fitness, max_correction_* and sigma_floor_* must be finite and > 0";
   if (min_inliers < 0) return "min_inliers must be >= 0";
+  if (!std::isfinite(sigma_fitness_reference) || sigma_fitness_reference < 0)
+    return "sigma_fitness_reference must be finite and >= 0";
   if (!(min_inlier_ratio >= 0 && min_inlier_ratio <= 1)) return "min_inlier_ratio must be in [0, 1]";
   return {};
 }
@@ -36,6 +38,8 @@ void setCovariance(const lidar::MatchResult& r, const LoopVerifierConfig& c, Loo
   cov = 0.5 * (cov + cov.transpose());
   cov.topLeftCorner<3, 3>().diagonal().array() += c.sigma_floor_position * c.sigma_floor_position;
   cov.bottomRightCorner<3, 3>().diagonal().array() += c.sigma_floor_rotation * c.sigma_floor_rotation;
+  if (c.sigma_fitness_reference > 0 && r.fitness > c.sigma_fitness_reference)
+    cov *= (r.fitness / c.sigma_fitness_reference) * (r.fitness / c.sigma_fitness_reference);
   v.covariance = cov;
   v.information = cov.inverse();
   v.information = 0.5 * (v.information + v.information.transpose());

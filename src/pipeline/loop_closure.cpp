@@ -39,6 +39,7 @@ struct LoopClosure::Impl {
   std::vector<double> degenerate_rotation_before;  // the same, their rotational share only (|phi|^2 of each)
   std::vector<double> path_before;  // [m] by keyframe: the odometry's path length up to it, as it was added
   std::vector<LoopEvent> events;
+  std::size_t events_dropped = 0;  // the oldest, erased past config.max_events
   LoopStats stats;
   VisualYawPrior visual_prior;
   int skip = 0;
@@ -278,6 +279,11 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
     }
   }
   events.push_back(e);
+  if (config.max_events > 0 && events.size() > static_cast<std::size_t>(config.max_events)) {
+    const std::size_t drop = events.size() / 2;  // half at a time: amortised O(1) a verification
+    events.erase(events.begin(), events.begin() + static_cast<std::ptrdiff_t>(drop));
+    events_dropped += drop;
+  }
   return e.verification.accepted;
 }
 
@@ -379,6 +385,7 @@ std::vector<Eigen::Isometry3d> LoopClosure::poses() const {
 bool LoopClosure::searched(std::size_t index) const { return index < impl_->searched.size() && impl_->searched[index]; }
 
 const std::vector<LoopEvent>& LoopClosure::events() const { return impl_->events; }
+std::size_t LoopClosure::eventsDropped() const { return impl_->events_dropped; }
 const LoopStats& LoopClosure::stats() const { return impl_->stats; }
 const LoopClosureConfig& LoopClosure::config() const { return impl_->config; }
 

@@ -99,12 +99,17 @@ struct LoopClosureConfig {
   // graph tilts the map by up to 1 deg (kitti05-replay); the smoother restarted on tilted poses reads g * tilt as
   // accelerometer bias (0.028 -> 0.13 m/s^2 over the farm's second lap), which the degenerate corridor then
   // integrates into a runaway velocity (6 m/s after 50 s, 234 m of drift). With budget_through_loops, the farm hour
-  // (6 laps) keeps a median error of 0.5-0.7 m a lap and a peak memory of 1.27x the first lap's (with neither:
-  // 1.48x, median errors up to 24 m a lap, heading errors up to 56 deg). Off by default: on one pass the 6-DoF
-  // graph's tilts also correct the odometry's height drift (accelerometer bias and tilt are one unknown until the
-  // heading turns), and with 4 DoF the APE rose from 3.58 to 4.58 m on the farm course (in and after the corridor)
-  // and from 0.40 to 0.48 m on kitti05-replay (height) (bench/RESULTS.md).
+  // (6 laps) keeps a median error of 0.6-0.7 m a lap and a peak memory of 1.17x the first lap's (with neither:
+  // 1.48x, median errors up to 24 m a lap, heading errors up to 56 deg). Off in the platform files, on in the drover
+  // preset: on one pass of the farm the LIS alone went from 3.58 to 4.58 m APE with it (in and after the corridor,
+  // where the 6-DoF graph's tilts also take up the height drift: accelerometer bias and tilt are one unknown until
+  // the heading turns); on kitti05-replay's LIS it is better (0.156 against 0.185 m with Scan Context's loops)
+  // (bench/RESULTS.md).
   bool four_dof_with_imu = false;
+  // Verified candidates kept for events() (report.json's list), the newest: past max_events the oldest half is
+  // dropped (eventsDropped() counts them), so a day-long run holds at most this many (~1 KB each) instead of every
+  // one (the farm course driven for an hour verifies ~2700). 0 keeps every event.
+  int max_events = 8192;
   backend::PoseGraphConfig graph;
   std::string validate() const;  // empty when valid
 };
@@ -183,7 +188,10 @@ class LoopClosure {
 
   std::vector<Eigen::Isometry3d> poses() const;  // T_world_lidar of every keyframe from the graph, by index
   bool searched(std::size_t index) const;        // keyframe `index` was queried for loops (not skipped)
+  // The verified candidates, oldest first: every one, or the newest ones once more than config.max_events were
+  // verified (events()[i] is the (eventsDropped() + i)-th of the run).
   const std::vector<LoopEvent>& events() const;
+  std::size_t eventsDropped() const;
   const LoopStats& stats() const;
   const LoopClosureConfig& config() const;
 

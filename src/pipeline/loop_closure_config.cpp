@@ -50,6 +50,7 @@ std::string LoopClosureConfig::validate() const {
     return "shift_fallback must be always, budget or never";
   if (submap_keyframes < 0 || max_verifications < 1 || skip_after_loop < 0)
     return "submap_keyframes and skip_after_loop must be >= 0, max_verifications >= 1";
+  if (max_events < 0) return "max_events must be >= 0 (0 keeps every event)";
   return {};
 }
 

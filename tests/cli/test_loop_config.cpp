@@ -29,6 +29,7 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   skip_degenerate_places: true
   budget_through_loops: true
   four_dof_with_imu: true
+  max_events: 100
   scan_context:
     sensor_height: 1.5
     auto_height: true
@@ -39,6 +40,7 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   verifier:
     max_fitness: 0.3
     min_inliers: 50
+    sigma_fitness_reference: 0.07
   graph:
     loop_loss: cauchy
     loop_loss_scale: 2.0
@@ -58,6 +60,7 @@ odometry:
   EXPECT_TRUE(c.loop.budget_through_loops);
   EXPECT_TRUE(c.loop.four_dof_with_imu);
   EXPECT_TRUE(c.loopClosure().graph.yaw_only_rotation);
+  EXPECT_EQ(c.loop.max_events, 100);
   EXPECT_EQ(c.loop.database.descriptor.sensor_height, 1.5);
   EXPECT_TRUE(c.loop.database.descriptor.auto_height);
   EXPECT_EQ(c.loop.database.descriptor.threshold, 0.2);
@@ -66,6 +69,7 @@ odometry:
   EXPECT_EQ(c.loop.database.exclude_recent, 20);
   EXPECT_EQ(c.loop.verifier.max_fitness, 0.3);
   EXPECT_EQ(c.loop.verifier.min_inliers, 50);
+  EXPECT_EQ(c.loop.verifier.sigma_fitness_reference, 0.07);
   EXPECT_EQ(c.loop.graph.loop_loss, backend::RobustLoss::kCauchy);
   EXPECT_EQ(c.loop.graph.loop_loss_scale, 2.0);
   EXPECT_EQ(c.loop.verifier.matcher.max_iterations, 17);  // the verifier matches as the odometry does
@@ -97,6 +101,8 @@ TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {
   EXPECT_TRUE(has(e, "line 2") && has(e, "loop.source") && has(e, "scancontext")) << e;
   e = errorOf(dir, "loop:\n  scan_context:\n    threshold: 5\n");
   EXPECT_TRUE(has(e, "threshold")) << e;
+  e = errorOf(dir, "loop:\n  max_events: -1\n");
+  EXPECT_TRUE(has(e, "max_events")) << e;
 }
 
 }  // namespace

@@ -1,13 +1,18 @@
 // What drover run keeps of its sweeps (apps/drover/run_record.hpp), bounded for hour-long runs: quantiles exact for
 // short runs and within their 1 % bins for long ones, the per-sweep lines streamed or the newest kept, the IMU-rate
-// odometry streamed in trajectory.tum's body frame.
+// odometry streamed in trajectory.tum's body frame; the heap's free pages handed back every 30 s.
 #include "apps/drover/run_record.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <string>
+#include <vector>
+
+#include "apps/drover/heap_tuning.hpp"
 
 #include "io/trajectory_io.hpp"
 #include "support/cli.hpp"
@@ -99,6 +104,48 @@ TEST(ImuRateFile, StreamsPosesInTheBodyFrameSkipsRepeatsAndCopiesWhatItHasSoFar)
   EXPECT_NEAR((copy[4].T_world_body.translation() - Eigen::Vector3d(4.05, 0, 0.3)).norm(), 0, 1e-9);
   EXPECT_EQ(file.copyTo((dir / "imu_rate.tum").string()).poses, 5u);  // onto itself: only flushed
   EXPECT_EQ(io::readTum((dir / "imu_rate.tum").string()).size(), 5u);
+}
+
+long residentKb() {
+  std::ifstream in("/proc/self/status");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return -1;
+}
+
+// With drover's heap settings nothing freed goes back to the kernel by itself; the trimmer returns it once per
+// period of data time. A sweep stamped at its start comes after the IMU samples of its revolution: such small steps
+// back must neither trim every sweep nor hold the trim off for ever; a jump back by more than a period restarts it.
+TEST(HeapTrimmer, HandsTheHeapsFreePagesBackOncePerPeriodOfDataTime) {
+  tuneHeapForSweeps();
+  HeapTrimmer trimmer(30'000'000'000);
+  EXPECT_FALSE(trimmer.tick(5'000'000'000)) << "the first tick starts the clock";
+  constexpr std::size_t kBlock = 1 << 20, kBlocks = 64;  // [bytes] below the 32 MiB mmap threshold: in the heap
+  std::vector<char*> blocks;
+  volatile char sink = 0;
+  for (std::size_t i = 0; i < kBlocks; ++i) {
+    blocks.push_back(static_cast<char*>(std::malloc(kBlock)));
+    std::memset(blocks.back(), 1, kBlock);
+    sink = sink + blocks.back()[kBlock / 2];
+  }
+  char* pin = static_cast<char*>(std::malloc(64));  // keeps the freed blocks inside the heap, not at its top
+  pin[0] = 1;
+  const long held = residentKb();
+  for (char* b : blocks) std::free(b);
+  EXPECT_FALSE(trimmer.tick(34'999'999'999));
+  EXPECT_GT(residentKb(), held - 8 * 1024) << "freed blocks stay resident between trims";
+  EXPECT_TRUE(trimmer.tick(35'000'000'000));
+  EXPECT_LT(residentKb(), held - 32 * 1024) << "the trim returns the 64 MiB freed inside the heap";
+  EXPECT_FALSE(trimmer.tick(64'000'000'000));
+  EXPECT_TRUE(trimmer.tick(65'000'000'000));
+  EXPECT_FALSE(trimmer.tick(64'900'000'000)) << "a small step back neither trims nor restarts the period";
+  EXPECT_FALSE(trimmer.tick(94'900'000'000));
+  EXPECT_TRUE(trimmer.tick(95'000'000'000));
+  EXPECT_FALSE(trimmer.tick(10'000'000'000)) << "a jump back by more than a period restarts it";
+  EXPECT_FALSE(trimmer.tick(39'900'000'000));
+  EXPECT_TRUE(trimmer.tick(40'000'000'000));
+  EXPECT_EQ(trimmer.trims(), 4);
+  std::free(pin);
 }
 
 }  // namespace

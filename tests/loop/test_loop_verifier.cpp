@@ -82,6 +82,27 @@ TEST(LoopVerifier, CovarianceIncludesTheFloorsAndIsTheInverseOfTheInformation) {
   EXPECT_LT((v.information - v.information.transpose()).norm(), 1e-9 * v.information.norm());
 }
 
+// A fit worse than sigma_fitness_reference widens the whole covariance by (fitness / reference)^2; a better one, or
+// a reference of 0, leaves it alone.
+TEST(LoopVerifier, AFitWorseThanTheFitnessReferenceWidensTheCovarianceByTheSquaredRatio) {
+  const lidar::FeatureSet candidate = courtyard(0);
+  const SubmapKeyframe submap[] = {{&candidate, Eigen::Isometry3d::Identity()}};
+  const lidar::FeatureSet query = seenFrom(candidate, pose(1, 1, 10));
+  const LoopVerification plain = LoopVerifier().verify(query, submap, 0, pose(1.2, 1, 12));
+  ASSERT_TRUE(plain.accepted) << plain.reason;
+  ASSERT_GT(plain.fitness, 1e-4);
+  LoopVerifierConfig c;
+  c.sigma_fitness_reference = plain.fitness / 3;  // this fit is 3x worse than the reference
+  const LoopVerification wide = LoopVerifier(c).verify(query, submap, 0, pose(1.2, 1, 12));
+  EXPECT_LT((wide.covariance - 9.0 * plain.covariance).norm(), 1e-9 * plain.covariance.norm());
+  EXPECT_LT((wide.covariance * wide.information - geometry::Matrix6d::Identity()).norm(), 1e-6);
+  EXPECT_EQ(wide.T_candidate_query.matrix(), plain.T_candidate_query.matrix()) << "only the covariance changes";
+  c.sigma_fitness_reference = plain.fitness * 2;  // a better fit than the reference
+  EXPECT_EQ(LoopVerifier(c).verify(query, submap, 0, pose(1.2, 1, 12)).covariance, plain.covariance);
+  c.sigma_fitness_reference = -0.1;
+  EXPECT_NE(c.validate().find("sigma_fitness_reference"), std::string::npos);
+}
+
 TEST(LoopVerifier, RejectsBadArguments) {
   const lidar::FeatureSet f = courtyard(0);
   const LoopVerifier verifier;

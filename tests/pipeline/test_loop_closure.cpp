@@ -264,6 +264,36 @@ std::unique_ptr<LoopClosure> twoLaps(const LoopClosureConfig& c) {
   return loops;
 }
 
+// A long run keeps only its newest verified candidates in memory (config.max_events); the loops it closes and the
+// poses are the same, and the counts still cover every one.
+TEST(LoopClosure, KeepsOnlyTheNewestEventsPastMaxEventsAndClosesTheSameLoops) {
+  LoopClosureConfig all = courtyardConfig();
+  all.max_events = 0;
+  const std::unique_ptr<LoopClosure> every = twoLaps(all);
+  const std::vector<LoopEvent>& full = every->events();
+  ASSERT_GE(full.size(), 10u);
+  EXPECT_EQ(every->eventsDropped(), 0u);
+  LoopClosureConfig bounded = courtyardConfig();
+  bounded.max_events = 4;
+  const std::unique_ptr<LoopClosure> newest = twoLaps(bounded);
+  const std::vector<LoopEvent>& kept = newest->events();
+  EXPECT_LE(kept.size(), 4u);
+  EXPECT_GE(kept.size(), 2u);
+  EXPECT_EQ(newest->eventsDropped() + kept.size(), full.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    const LoopEvent& twin = full[newest->eventsDropped() + i];
+    EXPECT_EQ(kept[i].query, twin.query);
+    EXPECT_EQ(kept[i].candidate, twin.candidate);
+  }
+  EXPECT_EQ(newest->stats().verified, every->stats().verified);
+  EXPECT_EQ(newest->stats().accepted, every->stats().accepted);
+  const std::vector<Eigen::Isometry3d> a = every->poses(), b = newest->poses();
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LT((a[i].translation() - b[i].translation()).norm(), 1e-12);
+  bounded.max_events = -1;
+  EXPECT_NE(bounded.validate().find("max_events"), std::string::npos);
+}
+
 // The second lap retires the first's keyframes, each by its twin a lap later. Where loops tied the laps together
 // the retired nodes merge and poses() still gives every keyframe where it was; with no loop (search disabled) or
 // with keep_retired_nodes, the graph keeps them all.
@@ -404,9 +434,9 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectorySt
   // Without loops this course gives 0.016 m (the lidar-inertial odometry alone is good here); the loops must not
   // spoil it. (One test: ctest runs each test in its own process, and the course takes ~15 s.)
   EXPECT_LT(r.ape, 0.05);
-  // The second pass supersedes the first where it drives it again (LocalMapConfig::retire_radius, 1 m, here 20 s):
-  // each retired keyframe has a keyframe at least 20 s newer within 1 m (its corrected pose: 1.1 m). Only the
-  // keyframes of the second pass's first 8 s become 20 s old before the course ends: 4 or 5 retire.
+  // The second pass supersedes the first where it drives it again (LocalMapConfig::retire_radius, 2 m, here 20 s):
+  // each retired keyframe has a keyframe at least 20 s newer within 2 m (its corrected pose: 2.1 m). Only the
+  // keyframes of the second pass's first 8 s become 20 s old before the course ends.
   std::printf("overlap: %zu keyframes, %zu retired\n", r.keyframes.size(), r.odometry.keyframes_retired);
   EXPECT_GE(r.odometry.keyframes_retired, 3u);
   std::size_t retired = 0;
@@ -416,7 +446,8 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectorySt
     EXPECT_TRUE(old.features().full.empty());
     const bool superseded = std::any_of(r.keyframes.begin(), r.keyframes.end(), [&](const lidar::Keyframe& k) {
       return k.t >= old.t + fromSeconds(20.0) &&
-             (k.T_world_lidar.translation() - old.T_world_lidar.translation()).norm() < 1.1;
+             (k.T_world_lidar.translation() - old.T_world_lidar.translation()).norm() <
+                 lidar::LocalMapConfig{}.retire_radius + 0.1;
     });
     EXPECT_TRUE(superseded) << "keyframe " << old.index;
   }

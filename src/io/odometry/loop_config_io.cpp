@@ -30,6 +30,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("skip_degenerate_places", c.skip_degenerate_places)
       .bind("budget_through_loops", c.budget_through_loops)
       .bind("four_dof_with_imu", c.four_dof_with_imu)
+      .bind("max_events", c.max_events)
       .nested("scan_context",
               [&](YamlSection& n) {
                 n.bind("rings", d.rings)
@@ -53,7 +54,8 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
                     .bind("max_correction_translation", v.max_correction_translation)
                     .bind("max_correction_rotation", v.max_correction_rotation)
                     .bind("sigma_floor_position", v.sigma_floor_position)
-                    .bind("sigma_floor_rotation", v.sigma_floor_rotation);
+                    .bind("sigma_floor_rotation", v.sigma_floor_rotation)
+                    .bind("sigma_fitness_reference", v.sigma_fitness_reference);
               })
       .nested("graph", [&](YamlSection& n) {
         n.bind("max_iterations", c.graph.max_iterations)
