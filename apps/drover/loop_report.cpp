@@ -122,6 +122,8 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
          {"source", pipeline::toString(loops.config().source)},
          {"graph_dof", loops.config().graph.yaw_only_rotation ? 4 : 6},  // 4: x, y, z, yaw (roll, pitch kept)
          {"radius_m", loops.config().radius},  // the radius search's reach (radius and both sources)
+         // a fit worse than this widens the loop's covariance by the squared ratio (0: off)
+         {"sigma_fitness_reference_m", loops.config().verifier.sigma_fitness_reference},
          {"queries", s.queries},
          {"candidates", s.candidates},
          {"verified", s.verified},

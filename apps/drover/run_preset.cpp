@@ -54,6 +54,10 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
     // belong to (g * 0.5 deg = 0.086 m/s^2): the LIS alone on the farm's seed 3 with LVI-SAM's radius loops drifted
     // to 5.6 m APE with the 6-DoF graph, 0.80 m with this one (bench/RESULTS.md).
     loop.four_dof_with_imu = true;
+    // A loop's covariance widens with its fit's residual beyond 5 cm: the radius loops against the first keyframe at
+    // the farm's end (fitness 0.15-0.18 m) were 1.2-2.2 deg off against the floors' 0.29 deg (NEES 20-28). Seeds 1-3
+    // 0.269 -> 0.261, 0.222 -> 0.222, 0.295 -> 0.288 m; kitti05-replay's LIS 0.162 -> 0.156 m (bench/RESULTS.md).
+    loop.verifier.sigma_fitness_reference = 0.05;
   } else if (preset == Preset::kLviSam) {
     f.factor = false;
     f.initial_guess = true;
@@ -69,6 +73,7 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
     // mapOptimization's pose is the scan match, its degenerate directions kept at the (VIS) guess.
     odometry.degenerate_pose_from_match = true;
     loop.four_dof_with_imu = false;  // LIO-SAM's keyframe graph (iSAM2) corrects all 6 DoF
+    loop.verifier.sigma_fitness_reference = 0.0;  // its loop noise is the ICP fitness score alone
   }
 }
 
@@ -89,8 +94,8 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
 }
 
 std::vector<std::string> partNames() {
-  return {"vo-factor",     "vis-guess", "vis-gates",    "visual-yaw-prior", "scan-context",
-          "radius-search", "four-dof",  "depth-factor", "superpoint"};
+  return {"vo-factor",     "vis-guess", "vis-gates",          "visual-yaw-prior", "scan-context",
+          "radius-search", "four-dof",  "loop-fitness-sigma", "depth-factor",     "superpoint"};
 }
 
 void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
@@ -104,6 +109,7 @@ void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
   if (part == "scan-context") odometry.loop.source = pipeline::LoopSource::kRadius;
   if (part == "radius-search") odometry.loop.source = pipeline::LoopSource::kScanContext;
   if (part == "four-dof") odometry.loop.four_dof_with_imu = false;
+  if (part == "loop-fitness-sigma") odometry.loop.verifier.sigma_fitness_reference = 0.0;
 }
 
 void removePart(const std::string& part, io::VisualConfig& visual, vio::VioConfig& vio) {

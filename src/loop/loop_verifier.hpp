@@ -35,7 +35,7 @@ struct LoopVerifierConfig {
   double sigma_floor_rotation = 0.005;      // [rad] added in quadrature to the fit's rotation sigma
   // A fit worse than this scales the whole covariance by (fitness / sigma_fitness_reference)^2: on the farm the
   // loops' error grows with their fitness (NEES < 0.1 below 0.05 m, 20-28 at 0.15-0.18 m against the floors' claim).
-  // 0 leaves the covariance as the fit and the floors give it.
+  // 0 leaves the covariance as the fit and the floors give it (the default); the drover preset sets 0.05 m.
   double sigma_fitness_reference = 0.0;     // [m]
   std::string validate() const;             // empty when valid
 };

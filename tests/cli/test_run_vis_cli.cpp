@@ -123,6 +123,7 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_EQ(r["preset"], "lvi-sam");
   EXPECT_EQ(r["loops"]["source"], "radius");
   EXPECT_EQ(r["loops"]["graph_dof"], 6) << "LIO-SAM's keyframe graph corrects all six degrees of freedom";
+  EXPECT_EQ(r["loops"]["sigma_fitness_reference_m"], 0.0);
   EXPECT_EQ(r["vis"]["depth_mode"], "fixed");
   EXPECT_EQ(r["vis"]["detector"], "shi-tomasi");
   EXPECT_EQ(r["counts"]["vis_factor_scans"], 0) << "LVI-SAM's released code has no visual odometry factor";
@@ -146,7 +147,8 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
 
 // The drover preset searches both loop sources (Scan Context and the 15 m radius search) whatever the platform file
 // names, in a 4-DoF graph; --without radius-search leaves Scan Context alone, --without scan-context the radius
-// search alone, --without four-dof the 6-DoF graph.
+// search alone, --without four-dof the 6-DoF graph. Its loops' covariances widen with their fits' residuals
+// (--without loop-fitness-sigma: the fit and the floors alone).
 TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTakesEachOut) {
   TempDir dir;
   const CliResult sim = simulate(dir);
@@ -164,13 +166,15 @@ TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTak
   struct Case {
     std::string name, config, without, source;
     int dof;
+    double fitness_reference = 0.05;  // [m]
   };
   const std::vector<Case> cases = {
       {"sc_file", shiTomasiConfig("farm_sim.yaml", dir.path()), "", "both", 4},
       {"radius_file", (dir / "radius.yaml").string(), "", "both", 4},
       {"no_radius", (dir / "radius.yaml").string(), "--without radius-search", "scancontext", 4},
       {"no_sc", (dir / "radius.yaml").string(), "--without scan-context", "radius", 4},
-      {"six_dof", (dir / "radius.yaml").string(), "--without four-dof", "both", 6}};
+      {"six_dof", (dir / "radius.yaml").string(), "--without four-dof", "both", 6},
+      {"no_fitness", (dir / "radius.yaml").string(), "--without loop-fitness-sigma", "both", 4, 0.0}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const CliResult r = runDrover("run " + (dir / "straight").string() + " --format sim --config " + c.config +
@@ -180,6 +184,7 @@ TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTak
     EXPECT_EQ(loops["source"], c.source);
     EXPECT_EQ(loops["graph_dof"], c.dof);
     EXPECT_EQ(loops["radius_m"], 15.0) << "LIO-SAM's historyKeyframeSearchRadius (Drover's own default is 10 m)";
+    EXPECT_EQ(loops["sigma_fitness_reference_m"], c.fitness_reference) << "a loop's covariance widens with its fit";
   }
 }
 
