@@ -103,6 +103,8 @@ TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {
   EXPECT_TRUE(has(e, "threshold")) << e;
   e = errorOf(dir, "loop:\n  max_events: -1\n");
   EXPECT_TRUE(has(e, "max_events")) << e;
+  e = errorOf(dir, "loop:\n  verifier:\n    sigma_fitness_reference: -0.05\n");
+  EXPECT_TRUE(has(e, "sigma_fitness_reference")) << e;
 }
 
 }  // namespace
