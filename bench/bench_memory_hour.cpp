@@ -20,7 +20,9 @@
 // The ground truth of every lap (10 Hz, T_world_imu) goes to OUT_DIR/bench_memory_truth.tum, for drover eval ape
 // against bench_memory_imu_rate.tum.
 //   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay|delayed] [LOOP_HZ=1] [CONFIG]
-// CONFIG: a platform file instead of config/farm_sim.yaml (to try a setting over the hour).
+//                                 [TRIM_S=30]
+// CONFIG: a platform file instead of config/farm_sim.yaml (to try a setting over the hour); TRIM_S: the period of
+// the heap trim [s of data time] (cli::HeapTrimmer's default is drover's).
 #include <fmt/format.h>
 #include <malloc.h>
 
@@ -29,6 +31,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <mutex>
@@ -117,6 +120,17 @@ void writeLoopEvents(const pipeline::LoopClosure& loops, const std::string& path
   }
 }
 
+// Every keyframe as the hour ended (replay and delayed modes): to see which places kept their clouds.
+void writeKeyframes(const lidar::LocalMap& map, const std::string& path) {
+  std::ofstream out(path);
+  out << "index,t_s,x_m,y_m,z_m,retired\n";
+  for (std::size_t i = 0; i < map.size(); ++i) {
+    const lidar::Keyframe& k = map.keyframe(i);
+    const Eigen::Vector3d p = k.T_world_lidar.translation();
+    out << fmt::format("{},{:.2f},{:.3f},{:.3f},{:.3f},{}\n", i, toSeconds(k.t), p.x(), p.y(), p.z(), k.retired ? 1 : 0);
+  }
+}
+
 // The System (live threads) or LidarOdometry (replay, in line) fed measurement by measurement.
 class Runner {
  public:
@@ -125,6 +139,7 @@ class Runner {
   virtual void fill(Lap& row) = 0;  // counts and memory so far
   virtual void finish() = 0;
   virtual const pipeline::LoopClosure* loops() const { return nullptr; }
+  virtual const lidar::LocalMap* keyframes() const { return nullptr; }
   cli::RunRecord record;
 };
 
@@ -196,6 +211,7 @@ class InlineRunner : public Runner {
   void finish() override {
     for (const pipeline::ScanOutcome& s : lis_.finish()) record.add(s);
   }
+  const lidar::LocalMap* keyframes() const override { return &lis_.keyframeMap(); }
 
  protected:
   void process(const Measurement& m) {
@@ -271,13 +287,13 @@ class DelayedRunner : public InlineRunner {
 
 int main(int argc, char** argv) {
   cli::tuneHeapForSweeps();  // the heap as drover run and drover_ros have it, returned every 30 s (HeapTrimmer)
-  cli::HeapTrimmer heap;
   const int laps = argc > 1 ? std::stoi(argv[1]) : 6;
   const unsigned seed = argc > 2 ? static_cast<unsigned>(std::stoul(argv[2])) : 1;
   const std::string out_dir = argc > 3 ? argv[3] : "/tmp";
   const std::string mode = argc > 4 ? argv[4] : "live";
   const double loop_hz = argc > 5 ? std::stod(argv[5]) : 1.0;
   const std::string config_path = argc > 6 ? argv[6] : "";
+  cli::HeapTrimmer heap(argc > 7 ? fromSeconds(std::stod(argv[7])) : cli::HeapTrimmer::kDefaultPeriod);
   if (mode != "live" && mode != "replay" && mode != "delayed") {
     std::fprintf(stderr, "MODE must be live, replay or delayed, not '%s'\n", mode.c_str());
     return 2;
@@ -306,6 +322,8 @@ int main(int argc, char** argv) {
       std::make_shared<cli::ImuRateFile>(out_dir + "/bench_memory_imu_rate.tum", Eigen::Isometry3d::Identity());
 
   std::vector<Lap> rows;
+  const bool hwm_log = std::getenv("DROVER_HWM_LOG") != nullptr;
+  long last_hwm = 0;
   const auto wall0 = std::chrono::steady_clock::now();
   std::printf("%s: lap  data_s  wall_s  sweeps  keyframes  retired  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  "
               "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms  iterations  "
@@ -315,6 +333,8 @@ int main(int argc, char** argv) {
     const Time offset = lap * lap_span;
     // Each lap its own noise (seed + lap); the same world and path: the robot drives the same course again.
     const sim::Simulator simulator(scenario, sc, seed + static_cast<unsigned>(lap) * 1000);
+    long lap_max_kb = 0;
+    Time lap_max_t = 0;
     const Trajectory lap_truth = simulator.groundTruth();
     for (std::size_t i = 0; i < lap_truth.size(); i += 20)
       truth.add({lap_truth[i].t + offset, lap_truth[i].T_world_body});
@@ -327,8 +347,25 @@ int main(int argc, char** argv) {
         scan->t_end += offset;
       }
       heap.tick(measurementTime(m));
+      const bool sweep = std::holds_alternative<LidarScan>(m);
+      const Time t = measurementTime(m);
       runner->push(std::move(m));
+      if (sweep) {  // where in the lap its resident memory was highest (sampled after every sweep)
+        const long rss = statusKb("VmRSS");
+        if (hwm_log) {  // DROVER_HWM_LOG: every sweep that raised the high-water mark by 1 MB or more
+          const long hwm = statusKb("VmHWM");
+          if (hwm >= last_hwm + 1024) std::printf("    hwm %.1f s: %.1f MB (resident after it %.1f MB)\n", toSeconds(t),
+                                                  hwm / 1024.0, rss / 1024.0);
+          last_hwm = std::max(last_hwm, hwm);
+        }
+        if (rss > lap_max_kb) {
+          lap_max_kb = rss;
+          lap_max_t = t;
+        }
+      }
     });
+    std::printf("  (lap %d: resident memory sampled after every sweep highest at %.1f s: %.1f MB)\n", lap + 1,
+                toSeconds(lap_max_t), lap_max_kb / 1024.0);
     Lap row;
     row.lap = lap + 1;
     row.data_s = toSeconds((lap + 1) * lap_span);
@@ -350,10 +387,17 @@ int main(int argc, char** argv) {
                 row.graph_nodes, row.heap_used / 1048576.0, row.heap_free / 1048576.0);
     std::fflush(stdout);
   }
+  // DROVER_EXIT_AT_END: leave without freeing anything, so that heaptrack reports what the hour holds at its end
+  // as "leaked", call site by call site (run 1 lap and 3, compare).
+  if (std::getenv("DROVER_EXIT_AT_END")) {
+    std::fflush(stdout);
+    std::_Exit(0);
+  }
   runner->finish();
   truth.close();
   if (const pipeline::LoopClosure* loops = runner->loops())
     writeLoopEvents(*loops, out_dir + "/bench_memory_loops.csv");
+  if (const lidar::LocalMap* map = runner->keyframes()) writeKeyframes(*map, out_dir + "/bench_memory_keyframes.csv");
   const Lap& first = rows.front();
   const Lap& last = rows.back();
   const auto mb = [](double kb) { return kb / 1024.0; };
@@ -364,8 +408,8 @@ int main(int argc, char** argv) {
               last.data_s / 60, mb(last.peak_kb), mb(kf_last));
   std::printf("ratio of peaks: %.2f overall, %.2f without the keyframe clouds\n",
               static_cast<double>(last.peak_kb) / first.peak_kb, (last.peak_kb - kf_last) / (first.peak_kb - kf_first));
-  std::printf("records streamed: %zu sweep lines, %zu IMU-rate poses; the heap trimmed %lld times\n",
+  std::printf("records streamed: %zu sweep lines, %zu IMU-rate poses; the heap trimmed %lld times (%.0f ms)\n",
               runner->record.log.lines(), runner->record.imu_rate->copyTo(out_dir + "/bench_memory_imu_rate.tum").poses,
-              static_cast<long long>(heap.trims()));
+              static_cast<long long>(heap.trims()), heap.trimSeconds() * 1e3);
   return 0;
 }

@@ -9,6 +9,7 @@
 // C++17 on purpose: drover_ros's main includes it (see apps/drover_ros/live_session.hpp).
 #include <malloc.h>
 
+#include <chrono>
 #include <cstdint>
 
 namespace drover::cli {
@@ -38,16 +39,20 @@ class HeapTrimmer {
     }
     if (now - last_ < period_) return false;
     last_ = now;
+    const auto t0 = std::chrono::steady_clock::now();
     malloc_trim(0);
+    trim_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ++trims_;
     return true;
   }
   std::int64_t trims() const { return trims_; }
+  double trimSeconds() const { return trim_s_; }  // [s] of wall time spent in malloc_trim
 
  private:
   std::int64_t period_;
   std::int64_t last_ = 0;
   std::int64_t trims_ = 0;
+  double trim_s_ = 0.0;
   bool started_ = false;
 };
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include "pipeline/lidar_odometry_impl.hpp"
 #include "pipeline/motion_models.hpp"
@@ -277,11 +278,12 @@ void LidarOdometry::Impl::accumulateDegeneracy(const ScanOutcome& out) {
     degenerate_since_kf += geometry::Matrix6d::Identity();
     return;
   }
-  // The VIS's motion carried the directions the match left open: the odometry did not drift along them, so the
-  // loop graph's edge need not yield there (it bent the fused corridor: farm APE 0.47 m without loops, 0.55 with).
-  if (out.vis_factor) return;
+  // The VIS's motion carried the directions the match left open: the edge yields there by the VIS's sigma, not the
+  // lidar's degenerate one (see LoopClosureConfig::vis_carried_sigma).
+  const double w = out.vis_factor ? std::pow(config.loop.vis_carried_sigma / config.loop.degenerate_sigma, 2) : 1.0;
+  if (w == 0.0) return;
   for (const geometry::Vector6d& d : out.degenerate_directions)
-    degenerate_since_kf += d.normalized() * d.normalized().transpose();
+    degenerate_since_kf += w * d.normalized() * d.normalized().transpose();
 }
 
 // The graph moved the keyframes: the map, every sweep (through its keyframe), the current sweep and the IMU

@@ -45,6 +45,7 @@ std::string LoopClosureConfig::validate() const {
       return "max_drift_ratio, degenerate_drift, max_rotation_drift_ratio and degenerate_rotation_drift must be "
              "finite and >= 0";
   if (!std::isfinite(min_age) || min_age < 0) return "min_age must be finite and >= 0 s";
+  if (!std::isfinite(vis_carried_sigma) || vis_carried_sigma < 0) return "vis_carried_sigma must be finite and >= 0";
   if (shift_fallback != ShiftFallback::kAlways && shift_fallback != ShiftFallback::kBudget &&
       shift_fallback != ShiftFallback::kNever)
     return "shift_fallback must be always, budget or never";

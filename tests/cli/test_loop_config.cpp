@@ -22,6 +22,7 @@ TEST(LoopConfigReader, TheLoopSectionReachesEveryPartOfTheLoopClosure) {
   source: both
   min_age: 12.5
   max_drift_ratio: 0.2
+  vis_carried_sigma: 0.2
   max_rotation_drift_floor: 0.3
   max_rotation_drift_ratio: 0.001
   degenerate_rotation_drift: 0.02
@@ -52,6 +53,7 @@ odometry:
   EXPECT_EQ(c.loop.source, pipeline::LoopSource::kBoth);
   EXPECT_EQ(c.loop.min_age, 12.5);
   EXPECT_EQ(c.loop.max_drift_ratio, 0.2);
+  EXPECT_EQ(c.loop.vis_carried_sigma, 0.2);
   EXPECT_EQ(c.loop.max_rotation_drift_floor, 0.3);
   EXPECT_EQ(c.loop.max_rotation_drift_ratio, 0.001);
   EXPECT_EQ(c.loop.degenerate_rotation_drift, 0.02);

@@ -4,6 +4,8 @@
 // Driven as `drover run` drives it: one time-ordered stream, the VIS started from the LIS and fed its sweeps.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <functional>
 #include <string>
 
 #include "io/odometry/odometry_config_io.hpp"
@@ -26,14 +28,17 @@ struct FusedRun {
   std::size_t resets_by_the_lis = 0;  // ScanOutcome::vis_reset done, as drover run does them
   double path = 0, end_error = 0;  // [m]
   Trajectory lis;                  // the LIS's sweep-rate poses
+  std::size_t degenerate_places = 0;  // keyframes the loop search skipped as degenerate (skip_degenerate_places)
 };
 
 // The replay of `course` up to `until` (0: all of it); with `factor` false the VIS's motion is only the matcher's
-// guess (drover run --without vo-factor).
-FusedRun runFused(const test::LiveCourse& course, Time until = 0, bool factor = true) {
+// guess (drover run --without vo-factor); `tweak` changes the platform file's odometry settings.
+FusedRun runFused(const test::LiveCourse& course, Time until = 0, bool factor = true,
+                  const std::function<void(pipeline::OdometryConfig&)>& tweak = {}) {
   const std::string yaml = std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml";
   pipeline::OdometryConfig odometry_config = io::loadOdometryConfig(yaml);
   odometry_config.vis_fusion.factor = factor;
+  if (tweak) tweak(odometry_config);
   pipeline::LidarOdometry lis(odometry_config, course.calibration);
   vio::VisConfig vis_config;
   vis_config.vio = io::loadVioConfig(yaml);
@@ -76,6 +81,7 @@ FusedRun runFused(const test::LiveCourse& course, Time until = 0, bool factor = 
   }
   lis.finish();
   r.stats = lis.stats();
+  r.degenerate_places = lis.loopClosure().stats().degenerate_places;
   const Trajectory& est = lis.trajectory();
   r.lis = est;
   const Eigen::Isometry3d T_lidar_imu = course.calibration.T_imu_lidar.inverse();
@@ -158,6 +164,29 @@ TEST(SimCorridorFusion, AllFourFaultsIncludingATexturelessStretchAreSurvivedWith
   ASSERT_GT(r.path, 30.0);
   EXPECT_GT(r.stats.vis_factor_scans, r.stats.scans_processed / 2) << "the VIS re-joined";
   EXPECT_LT(r.end_error / r.path, 0.03);
+}
+
+// A degenerate sweep whose motion the VIS carried loosens the loop graph's odometry edge along its degenerate
+// directions by loop.vis_carried_sigma (the VIS drifts along the corridor too, less than the IMU alone; a loop's
+// correction belongs where the drift was) or, at 0, leaves it as tight as the lidar's. Seen through the loop search:
+// with skip_degenerate_places it skips the keyframes whose edges carry degenerate directions.
+TEST(SimCorridorFusion, TheSweepsTheVisCarriedLoosenTheLoopGraphsOdometryEdgesByTheVisSigma) {
+  constexpr Time kS = 1'000'000'000;
+  const test::LiveCourse course = test::simulateLiveCourse("corridor", 0, 1, true);
+  const Time until = course.truth.front().t + 12 * kS;
+  const auto sigma = [](double s) {
+    return [s](pipeline::OdometryConfig& c) {
+      c.loop.skip_degenerate_places = true;
+      c.loop.vis_carried_sigma = s;  // [m or rad per sweep]
+    };
+  };
+  EXPECT_GT(pipeline::LoopClosureConfig{}.vis_carried_sigma, 0.0) << "loosened by default";
+  const FusedRun loose = runFused(course, until, true, sigma(0.05));
+  const FusedRun tight = runFused(course, until, true, sigma(0.0));
+  ASSERT_GT(loose.stats.vis_factor_scans, 50u) << "the VIS must be fused for this to test anything";
+  std::printf("degenerate places: %zu loosened, %zu held tight (%zu sweeps with the VO factor)\n",
+              loose.degenerate_places, tight.degenerate_places, loose.stats.vis_factor_scans);
+  EXPECT_GE(loose.degenerate_places, tight.degenerate_places + 5);
 }
 
 // The replay is a function of its input. The LIS's worker threads make the heap's layout differ from run to run, so

@@ -20,6 +20,7 @@ void bindLoopSection(YamlSection& s, pipeline::LoopClosureConfig& c, LoopEnumStr
       .bind("odometry_sigma_position", c.odometry_sigma_position)
       .bind("odometry_sigma_rotation", c.odometry_sigma_rotation)
       .bind("degenerate_sigma", c.degenerate_sigma)
+      .bind("vis_carried_sigma", c.vis_carried_sigma)
       .bind("max_drift_floor", c.max_drift_floor)
       .bind("max_drift_ratio", c.max_drift_ratio)
       .bind("degenerate_drift", c.degenerate_drift)

@@ -4,7 +4,7 @@
 //   loop: enabled, source (scancontext | radius | both), yaw_prior, visual_yaw_prior, shift_fallback (always | budget | never),
 //         min_age [s], submap_keyframes,
 //         max_verifications, skip_after_loop, radius [m], odometry_sigma_position [m], odometry_sigma_rotation [rad],
-//         degenerate_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m],
+//         degenerate_sigma, vis_carried_sigma, max_drift_floor [m], max_drift_ratio, degenerate_drift [m],
 //         max_rotation_drift_floor [rad], max_rotation_drift_ratio [rad/m], degenerate_rotation_drift [rad],
 //         keep_retired_nodes, skip_degenerate_places, budget_through_loops, four_dof_with_imu, max_events [events]
 //     scan_context: rings, sectors, max_radius [m], sensor_height [m], auto_height, ground_lift [m], threshold,
