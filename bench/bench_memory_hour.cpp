@@ -127,7 +127,8 @@ void writeKeyframes(const lidar::LocalMap& map, const std::string& path) {
   for (std::size_t i = 0; i < map.size(); ++i) {
     const lidar::Keyframe& k = map.keyframe(i);
     const Eigen::Vector3d p = k.T_world_lidar.translation();
-    out << fmt::format("{},{:.2f},{:.3f},{:.3f},{:.3f},{}\n", i, toSeconds(k.t), p.x(), p.y(), p.z(), k.retired ? 1 : 0);
+    out << fmt::format("{},{:.2f},{:.3f},{:.3f},{:.3f},{}\n", i, toSeconds(k.t), p.x(), p.y(), p.z(),
+                       k.retired ? 1 : 0);
   }
 }
 

@@ -124,6 +124,7 @@ Json loopsJson(const RunContext& c, const pipeline::LidarOdometry& odometry, con
          {"radius_m", loops.config().radius},  // the radius search's reach (radius and both sources)
          // a fit worse than this widens the loop's covariance by the squared ratio (0: off)
          {"sigma_fitness_reference_m", loops.config().verifier.sigma_fitness_reference},
+         {"vis_carried_sigma", loops.config().vis_carried_sigma},
          {"queries", s.queries},
          {"candidates", s.candidates},
          {"verified", s.verified},

@@ -95,7 +95,8 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
 
 std::vector<std::string> partNames() {
   return {"vo-factor",     "vis-guess", "vis-gates",          "visual-yaw-prior", "scan-context",
-          "radius-search", "four-dof",  "loop-fitness-sigma", "depth-factor",     "superpoint"};
+          "radius-search", "four-dof",  "loop-fitness-sigma", "vis-carried-sigma", "depth-factor",
+          "superpoint"};
 }
 
 void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
@@ -110,6 +111,7 @@ void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
   if (part == "radius-search") odometry.loop.source = pipeline::LoopSource::kScanContext;
   if (part == "four-dof") odometry.loop.four_dof_with_imu = false;
   if (part == "loop-fitness-sigma") odometry.loop.verifier.sigma_fitness_reference = 0.0;
+  if (part == "vis-carried-sigma") odometry.loop.vis_carried_sigma = 0.0;
 }
 
 void removePart(const std::string& part, io::VisualConfig& visual, vio::VioConfig& vio) {

@@ -148,7 +148,8 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
 // The drover preset searches both loop sources (Scan Context and the 15 m radius search) whatever the platform file
 // names, in a 4-DoF graph; --without radius-search leaves Scan Context alone, --without scan-context the radius
 // search alone, --without four-dof the 6-DoF graph. Its loops' covariances widen with their fits' residuals
-// (--without loop-fitness-sigma: the fit and the floors alone).
+// (--without loop-fitness-sigma: the fit and the floors alone); its edges yield by the VIS's sigma where the VIS
+// carried a degenerate sweep (--without vis-carried-sigma: as tight as the lidar's).
 TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTakesEachOut) {
   TempDir dir;
   const CliResult sim = simulate(dir);
@@ -167,6 +168,7 @@ TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTak
     std::string name, config, without, source;
     int dof;
     double fitness_reference = 0.05;  // [m]
+    double vis_carried_sigma = 0.1;   // [m or rad a sweep]
   };
   const std::vector<Case> cases = {
       {"sc_file", shiTomasiConfig("farm_sim.yaml", dir.path()), "", "both", 4},
@@ -174,7 +176,8 @@ TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTak
       {"no_radius", (dir / "radius.yaml").string(), "--without radius-search", "scancontext", 4},
       {"no_sc", (dir / "radius.yaml").string(), "--without scan-context", "radius", 4},
       {"six_dof", (dir / "radius.yaml").string(), "--without four-dof", "both", 6},
-      {"no_fitness", (dir / "radius.yaml").string(), "--without loop-fitness-sigma", "both", 4, 0.0}};
+      {"no_fitness", (dir / "radius.yaml").string(), "--without loop-fitness-sigma", "both", 4, 0.0},
+      {"no_vis_sigma", (dir / "radius.yaml").string(), "--without vis-carried-sigma", "both", 4, 0.05, 0.0}};
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     const CliResult r = runDrover("run " + (dir / "straight").string() + " --format sim --config " + c.config +
@@ -185,6 +188,7 @@ TEST(VisRun, PresetDroverSearchesBothLoopSourcesInAFourDofGraphAndTheAblationTak
     EXPECT_EQ(loops["graph_dof"], c.dof);
     EXPECT_EQ(loops["radius_m"], 15.0) << "LIO-SAM's historyKeyframeSearchRadius (Drover's own default is 10 m)";
     EXPECT_EQ(loops["sigma_fitness_reference_m"], c.fitness_reference) << "a loop's covariance widens with its fit";
+    EXPECT_EQ(loops["vis_carried_sigma"], c.vis_carried_sigma);
   }
 }
 
