@@ -107,6 +107,8 @@ TEST(LoopConfigReader, AnUnknownLoopKeyOrSourceNamesItsLineAndKey) {
   EXPECT_TRUE(has(e, "max_events")) << e;
   e = errorOf(dir, "loop:\n  verifier:\n    sigma_fitness_reference: -0.05\n");
   EXPECT_TRUE(has(e, "sigma_fitness_reference")) << e;
+  e = errorOf(dir, "loop:\n  vis_carried_sigma: -0.1\n");
+  EXPECT_TRUE(has(e, "vis_carried_sigma")) << e;
 }
 
 }  // namespace
