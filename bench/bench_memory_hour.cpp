@@ -132,6 +132,32 @@ void writeKeyframes(const lidar::LocalMap& map, const std::string& path) {
   }
 }
 
+// Resident memory sampled after every sweep: where in the lap it was highest, and with DROVER_HWM_LOG every sweep
+// that raised the process's high-water mark by 1 MB or more.
+class PeakWatch {
+ public:
+  void startLap() { lap_max_kb_ = 0, lap_max_t_ = 0; }
+  void afterSweep(Time t) {
+    const long rss = statusKb("VmRSS");
+    if (log_) {
+      const long hwm = statusKb("VmHWM");
+      if (hwm >= last_hwm_ + 1024)
+        std::printf("    hwm %.1f s: %.1f MB (resident after it %.1f MB)\n", toSeconds(t), hwm / 1024.0, rss / 1024.0);
+      last_hwm_ = std::max(last_hwm_, hwm);
+    }
+    if (rss > lap_max_kb_) lap_max_kb_ = rss, lap_max_t_ = t;
+  }
+  void printLap(int lap) const {
+    std::printf("  (lap %d: resident memory sampled after every sweep highest at %.1f s: %.1f MB)\n", lap,
+                toSeconds(lap_max_t_), lap_max_kb_ / 1024.0);
+  }
+
+ private:
+  bool log_ = std::getenv("DROVER_HWM_LOG") != nullptr;
+  long last_hwm_ = 0, lap_max_kb_ = 0;  // [kB]
+  Time lap_max_t_ = 0;
+};
+
 // The System (live threads) or LidarOdometry (replay, in line) fed measurement by measurement.
 class Runner {
  public:
@@ -323,8 +349,7 @@ int main(int argc, char** argv) {
       std::make_shared<cli::ImuRateFile>(out_dir + "/bench_memory_imu_rate.tum", Eigen::Isometry3d::Identity());
 
   std::vector<Lap> rows;
-  const bool hwm_log = std::getenv("DROVER_HWM_LOG") != nullptr;
-  long last_hwm = 0;
+  PeakWatch peaks;
   const auto wall0 = std::chrono::steady_clock::now();
   std::printf("%s: lap  data_s  wall_s  sweeps  keyframes  retired  loops  dropped  RSS_MB  peak_MB  kf_LIS_MB  "
               "kf_loop_MB  cache_MB  SC_MB  | verified  accepted  over_budget  graph_refused  graph_ms  iterations  "
@@ -334,8 +359,7 @@ int main(int argc, char** argv) {
     const Time offset = lap * lap_span;
     // Each lap its own noise (seed + lap); the same world and path: the robot drives the same course again.
     const sim::Simulator simulator(scenario, sc, seed + static_cast<unsigned>(lap) * 1000);
-    long lap_max_kb = 0;
-    Time lap_max_t = 0;
+    peaks.startLap();
     const Trajectory lap_truth = simulator.groundTruth();
     for (std::size_t i = 0; i < lap_truth.size(); i += 20)
       truth.add({lap_truth[i].t + offset, lap_truth[i].T_world_body});
@@ -347,26 +371,13 @@ int main(int argc, char** argv) {
         scan->t += offset;
         scan->t_end += offset;
       }
-      heap.tick(measurementTime(m));
-      const bool sweep = std::holds_alternative<LidarScan>(m);
       const Time t = measurementTime(m);
+      const bool sweep = std::holds_alternative<LidarScan>(m);
+      heap.tick(t);
       runner->push(std::move(m));
-      if (sweep) {  // where in the lap its resident memory was highest (sampled after every sweep)
-        const long rss = statusKb("VmRSS");
-        if (hwm_log) {  // DROVER_HWM_LOG: every sweep that raised the high-water mark by 1 MB or more
-          const long hwm = statusKb("VmHWM");
-          if (hwm >= last_hwm + 1024) std::printf("    hwm %.1f s: %.1f MB (resident after it %.1f MB)\n", toSeconds(t),
-                                                  hwm / 1024.0, rss / 1024.0);
-          last_hwm = std::max(last_hwm, hwm);
-        }
-        if (rss > lap_max_kb) {
-          lap_max_kb = rss;
-          lap_max_t = t;
-        }
-      }
+      if (sweep) peaks.afterSweep(t);
     });
-    std::printf("  (lap %d: resident memory sampled after every sweep highest at %.1f s: %.1f MB)\n", lap + 1,
-                toSeconds(lap_max_t), lap_max_kb / 1024.0);
+    peaks.printLap(lap + 1);
     Lap row;
     row.lap = lap + 1;
     row.data_s = toSeconds((lap + 1) * lap_span);
