@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "vio/solver_log.hpp"
+
 namespace drover::vio {
 
 namespace {
@@ -178,6 +180,7 @@ class Reconstruction {
     problem.SetParameterBlockConstant(q[l].coeffs().data());
     problem.SetParameterBlockConstant(t[l].data());
     problem.SetParameterBlockConstant(t[last].data());
+    quietSolverWarnings();
     ceres::Solver::Options options;
     options.linear_solver_type = ceres::DENSE_SCHUR;
     options.max_num_iterations = 100;

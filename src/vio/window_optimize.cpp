@@ -1,7 +1,6 @@
 // The window's nonlinear least squares (VINS-Mono Sec. VI, Eq. 22): marginal prior, IMU preintegration and bias
 // random walk, robust reprojection of every usable feature, and LVI-SAM's lidar depth; then outliers and gauge.
 #include <ceres/ceres.h>
-#include <glog/logging.h>
 
 #include <algorithm>
 #include <chrono>
@@ -13,6 +12,7 @@
 #include "backend/schur_marginalizer.hpp"
 #include "backend/state_prior_factor.hpp"
 #include "backend/visual_factors.hpp"
+#include "vio/solver_log.hpp"
 #include "vio/window_frame.hpp"
 #include "vio/window_residuals.hpp"
 
@@ -25,16 +25,6 @@ constexpr double kRepropagateGyro = 0.01;  // [rad/s]
 constexpr double kMinDepth = 0.05;         // [m] in the observing camera for a reprojection factor to be added
 
 double yawOf(const Eigen::Matrix3d& R) { return std::atan2(R(1, 0), R(0, 0)); }
-
-// Ceres reports a rejected trial step through glog at WARNING level, once per step: a normal event in a
-// trust-region solve that would flood a run's terminal. Errors still print.
-void quietSolverWarnings() {
-  static const bool once = [] {
-    FLAGS_minloglevel = std::max(FLAGS_minloglevel, 2);  // google::GLOG_ERROR
-    return true;
-  }();
-  (void)once;
-}
 
 const backend::RightQuaternionManifold& quaternionManifold() {
   static const backend::RightQuaternionManifold manifold;
