@@ -42,6 +42,7 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
   if (preset == Preset::kDrover) {
     odometry.degenerate_pose_from_match = false;
     f.factor = f.initial_guess = true;
+    f.factor_degenerate_only = f.initial_guess_degenerate_only = true;  // where the lidar does not hold the pose
     f.reset_after = pipeline::VisualMotionConfig{}.reset_after;
     // Scan Context finds the places the odometry has drifted far from (the farm's seeds 1 and 2 after the white
     // walls); the radius search beside it (LIO-SAM's 15 m) the parallel passes a few metres apart that Scan Context's
@@ -61,6 +62,7 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
   } else if (preset == Preset::kLviSam) {
     f.factor = false;
     f.initial_guess = true;
+    f.initial_guess_degenerate_only = false;  // updateInitialGuess: the VIS's motion on every sweep
     withoutGates(f);
     // LIO-SAM / LVI-SAM params_lidar.yaml: historyKeyframeSearchRadius 15 m, historyKeyframeSearchTimeDiff 30 s,
     // keyframes every 1 m or 0.2 rad.

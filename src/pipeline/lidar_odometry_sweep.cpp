@@ -130,10 +130,12 @@ bool LidarOdometry::Impl::preprocess(LidarScan& scan, ScanOutcome& out) {
   return true;
 }
 
-// The VIS's motion since the previous sweep while a healthy VIS runs (LVI-SAM), else the IMU prediction when the
-// fusion is running, else constant velocity from the last two poses.
+// The VIS's motion since the previous sweep while a healthy VIS runs (LVI-SAM; with initial_guess_degenerate_only
+// only after a degenerate sweep), else the IMU prediction when the fusion is running, else constant velocity from
+// the last two poses.
 Eigen::Isometry3d LidarOdometry::Impl::guess(Time t, bool& from_imu, ScanOutcome& out) const {
-  if (!recent.empty()) {
+  const bool vis_wanted = !config.vis_fusion.initial_guess_degenerate_only || degenerate_run > 0;
+  if (!recent.empty() && vis_wanted) {
     if (std::optional<Eigen::Isometry3d> p = fusion.visualLidarGuess(t, recent.back(), &out.vis_unused)) {
       out.vis_guess = from_imu = true;  // the VIS's motion is visual-inertial
       return *p;

@@ -24,6 +24,12 @@ namespace drover::pipeline {
 struct VisualMotionConfig {
   bool factor = true;          // the VIS's motion as a relative-pose factor in the LIS's IMU smoother
   bool initial_guess = true;   // the VIS's motion as the scan matcher's initial guess (else the IMU's)
+  // The guess too only after a degenerate sweep (the matcher keeps a degenerate match's directions at its guess, so
+  // there the VIS's motion carries them), the IMU's where the previous match constrained all six directions: there
+  // the IMU's prediction from the smoother's state is the better start, and a match is not quite independent of
+  // where it starts. On kitti05-replay (never degenerate) the VIS's guess on every sweep cost 0.156 -> 0.160 m of
+  // APE with the drover preset (bench/RESULTS.md). false: LVI-SAM's updateInitialGuess, the VIS's on every sweep.
+  bool initial_guess_degenerate_only = true;
   // The factor only on sweeps whose match is degenerate: where the lidar constrains all six directions its pose
   // (to the map, ~1 cm) is better than the VIS's motion (2 cm + 5 %), whose errors are correlated from sweep to
   // sweep (one window) and pull the estimate off. On kitti05-replay (never degenerate, up to 14 m/s) the factor on

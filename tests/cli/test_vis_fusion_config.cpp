@@ -20,6 +20,7 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
   const pipeline::VisualMotionConfig c =
       load(dir,
            "odometry:\n  vis_fusion:\n    factor: false\n    factor_degenerate_only: true\n    initial_guess: false\n"
+           "    initial_guess_degenerate_only: false\n"
            "    sigma_position: 0.03\n"
            "    sigma_position_ratio: 0.06\n    sigma_rotation: 0.02\n    sigma_rotation_ratio: 0.07\n"
            "    min_features: 25\n    full_features: 90\n    warmup: 1.5\n    max_age: 0.25\n"
@@ -30,6 +31,7 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_FALSE(c.factor);
   EXPECT_TRUE(c.factor_degenerate_only);
   EXPECT_FALSE(c.initial_guess);
+  EXPECT_FALSE(c.initial_guess_degenerate_only);
   EXPECT_DOUBLE_EQ(c.sigma_position, 0.03);
   EXPECT_DOUBLE_EQ(c.sigma_position_ratio, 0.06);
   EXPECT_DOUBLE_EQ(c.sigma_rotation, 0.02);

@@ -111,6 +111,7 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
   s.bind("factor", c.factor)
       .bind("factor_degenerate_only", c.factor_degenerate_only)
       .bind("initial_guess", c.initial_guess)
+      .bind("initial_guess_degenerate_only", c.initial_guess_degenerate_only)
       .bind("sigma_position", c.sigma_position)
       .bind("sigma_position_ratio", c.sigma_position_ratio)
       .bind("sigma_rotation", c.sigma_rotation)

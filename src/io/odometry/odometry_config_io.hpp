@@ -17,7 +17,8 @@
 //     keyframes:    distance [m], angle [rad]
 //     imu:          gyro_noise_density, acc_noise_density, gyro_bias_random_walk, acc_bias_random_walk, gravity
 //     smoother:     window, max_iterations, ...
-//     vis_fusion:   factor, initial_guess (the VIS's motion in the LIS, while a VIS runs), sigma_position [m],
+//     vis_fusion:   factor, factor_degenerate_only, initial_guess, initial_guess_degenerate_only (the VIS's motion in
+//                   the LIS, while a VIS runs), sigma_position [m],
 //                   sigma_position_ratio [m/m], sigma_rotation [rad], sigma_rotation_ratio [rad/rad],
 //                   window_covariance (bool), window_floor_position [m], window_floor_rotation [rad], min_features,
 //                   full_features, warmup [s], max_age [s], max_keyframe_gap [s], standing_speed [m/s],
