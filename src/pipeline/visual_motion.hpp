@@ -28,7 +28,8 @@ struct VisualMotionConfig {
   // there the VIS's motion carries them), the IMU's where the previous match constrained all six directions: there
   // the IMU's prediction from the smoother's state is the better start, and a match is not quite independent of
   // where it starts. On kitti05-replay (never degenerate) the VIS's guess on every sweep cost 0.156 -> 0.160 m of
-  // APE with the drover preset (bench/RESULTS.md). false: LVI-SAM's updateInitialGuess, the VIS's on every sweep.
+  // APE with the drover preset; the farm's seeds 1-4 went 0.236 / 0.219 / 0.222 / 0.135 -> 0.224 / 0.180 / 0.224 /
+  // 0.203 m, within one seed's spread (bench/RESULTS.md). false: LVI-SAM's updateInitialGuess, on every sweep.
   bool initial_guess_degenerate_only = true;
   // The factor only on sweeps whose match is degenerate: where the lidar constrains all six directions its pose
   // (to the map, ~1 cm) is better than the VIS's motion (2 cm + 5 %), whose errors are correlated from sweep to
