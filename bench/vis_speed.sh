@@ -34,10 +34,9 @@ import json, sys
 r = json.load(open(sys.argv[1]))
 v = r["vis"]
 ms = v["ms_per_frame"]
-resets = v["resets"] if isinstance(v["resets"], int) else len(v["resets"])
 print(f"| {sys.argv[2]} | {sys.argv[3]} | {r['wall_s']:.1f} | {r['real_time_factor']:.2f} | {ms['track']:.1f} | "
       f"{ms['solve']:.1f} | {ms['marginalize']:.1f} | {ms['solve'] + ms['marginalize']:.1f} | "
-      f"{v['frames_estimated']} of {v['frames_in']} | {resets} | {v.get('ape', {}).get('rmse', float('nan')):.3f} |")
+      f"{v['frames_estimated']} of {v['frames_in']} | {v['resets']} | {v.get('ape', {}).get('rmse', float('nan')):.3f} |")
 PY
   done
 done
