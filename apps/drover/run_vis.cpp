@@ -134,6 +134,10 @@ void RunVis::record(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
   if (r.reset) {
     noteReset(r.t, r.event);
+  } else if (r.rescaled) {
+    ++rescales_;
+    spdlog::info("VIS rescaled at {:.3f} s: {}", toSeconds(r.t), r.event);
+    if (events_.size() < kMaxEvents) events_.push_back({r.t, "rescaled", r.event});
   } else if (r.just_initialized) {
     if (!first_init_) first_init_ = r.t;
     spdlog::info("VIS {} at {:.3f} s", r.event, toSeconds(r.t));
@@ -165,6 +169,8 @@ Json RunVis::report() const {
   if (first_init_) j["first_init_s"] = toSeconds(*first_init_);
   if (!first_init_) j["not_initialized_because"] = waiting_;
   j["resets"] = resets_;
+  j["rescales"] = rescales_;
+  j["scale_checks"] = vo_ != nullptr ? vo_->estimator().scaleChecks() : 0;
   j["time_offset_s"] = vo_ != nullptr ? vo_->estimator().timeOffset() : 0.0;
   Json events = Json::array();
   for (const Event& e : events_) events.push_back({{"t", toSeconds(e.t)}, {"kind", e.kind}, {"what", e.what}});

@@ -32,7 +32,7 @@ std::string VisualMotionConfig::validate() const {
 }
 
 std::optional<VisualState> VisualStateStream::onFrame(const vio::FrameResult& r) {
-  if (r.just_initialized) {
+  if (r.just_initialized || r.rescaled) {  // the VIS's world starts again: no motion measured across it
     ++init_count_;
     init_time_ = keyframe_time_ = r.t;
     keyframe_interval_ = 0;

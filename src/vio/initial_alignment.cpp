@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -55,6 +56,21 @@ Eigen::VectorXd solveLeastSquares(const Eigen::MatrixXd& A, const Eigen::VectorX
   return A.colPivHouseholderQr().solve(b);
 }
 
+// Standard error of the last unknown of the least squares A x = b from its residuals (Gauss-Markov, rows of
+// equal noise): sigma^2 = |A x - b|^2 / (rows - cols), var(x_last) = sigma^2 [(A^T A)^-1]_last,last.
+double lastUnknownSigma(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, const Eigen::VectorXd& x) {
+  const Eigen::Index dof = A.rows() - A.cols();
+  if (dof <= 0) return std::numeric_limits<double>::infinity();
+  const double sigma2 = (A * x - b).squaredNorm() / static_cast<double>(dof);
+  const Eigen::MatrixXd N = A.transpose() * A;
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(N);
+  if (qr.rank() < N.cols()) return std::numeric_limits<double>::infinity();
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(N.cols());
+  e(e.size() - 1) = 1;
+  const double var = sigma2 * qr.solve(e)(e.size() - 1);
+  return var >= 0 && std::isfinite(var) ? std::sqrt(var) : std::numeric_limits<double>::infinity();
+}
+
 LinearAlignment unpack(const Eigen::VectorXd& x, int n, const Eigen::Vector3d& g) {
   LinearAlignment out;
   for (int k = 0; k < n; ++k) out.v_imu.push_back(x.segment<3>(3 * k));
@@ -92,6 +108,7 @@ std::string AlignmentConfig::validate() const {
   if (!(min_acc_excitation >= 0)) out << "min_acc_excitation = " << min_acc_excitation << " must be >= 0; ";
   if (!(max_gravity_error > 0)) out << "max_gravity_error = " << max_gravity_error << " must be > 0; ";
   if (!(min_scale >= 0) || !std::isfinite(min_scale)) out << "min_scale = " << min_scale << " must be >= 0; ";
+  if (!(max_scale_rel_sigma > 0)) out << "max_scale_rel_sigma = " << max_scale_rel_sigma << " must be > 0; ";
   if (gyro_bias_iterations < 1) out << "gyro_bias_iterations = " << gyro_bias_iterations << " must be >= 1; ";
   if (refine_gravity_iterations < 1) {
     out << "refine_gravity_iterations = " << refine_gravity_iterations << " must be >= 1; ";
@@ -159,37 +176,85 @@ Eigen::Vector3d solveGyroscopeBias(const std::vector<Eigen::Matrix3d>& R_l_imu,
   return H.ldlt().solve(g);
 }
 
+namespace {
+
+// The system in the inverse scale (AlignmentConfig::inverse_scale says why): the unknowns u_k = v_k / s,
+// h = g / s and lambda = 1 / s; the SfM positions move to the right-hand side and lambda's column is the IMU's.
+// Every column of A then holds IMU quantities (and the rotations), the SfM's position noise only b.
+void invertSystem(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, Eigen::MatrixXd& A_inv, Eigen::VectorXd& b_inv) {
+  const Eigen::Index s_col = A.cols() - 1;
+  A_inv = A;
+  A_inv.col(s_col) = -b;
+  b_inv = -A.col(s_col);
+}
+
+}  // namespace
+
 LinearAlignment linearAlignment(const std::vector<Eigen::Matrix3d>& R_l_imu, const std::vector<Eigen::Vector3d>& p_l_cam,
-                                const Eigen::Vector3d& p_imu_cam, const std::vector<imu::Preintegrator>& preintegrations) {
+                                const Eigen::Vector3d& p_imu_cam, const std::vector<imu::Preintegrator>& preintegrations,
+                                bool inverse_scale) {
   Eigen::MatrixXd A;
   Eigen::VectorXd b;
   buildSystem(R_l_imu, p_l_cam, p_imu_cam, preintegrations, A, b);
-  const Eigen::VectorXd x = solveLeastSquares(A, b);
   const int n = static_cast<int>(R_l_imu.size());
+  if (!inverse_scale) {
+    const Eigen::VectorXd x = solveLeastSquares(A, b);
+    return unpack(x, n, x.segment<3>(3 * n));
+  }
+  Eigen::MatrixXd A_inv;
+  Eigen::VectorXd b_inv;
+  invertSystem(A, b, A_inv, b_inv);
+  const Eigen::VectorXd y = solveLeastSquares(A_inv, b_inv);
+  const double lambda = y(y.size() - 1);
+  Eigen::VectorXd x = y / lambda;
+  x(x.size() - 1) = 1 / lambda;
   return unpack(x, n, x.segment<3>(3 * n));
 }
 
 LinearAlignment refineGravity(const std::vector<Eigen::Matrix3d>& R_l_imu, const std::vector<Eigen::Vector3d>& p_l_cam,
                               const Eigen::Vector3d& p_imu_cam, const std::vector<imu::Preintegrator>& preintegrations,
-                              const Eigen::Vector3d& g0_in, double gravity, int iterations) {
+                              const Eigen::Vector3d& g0_in, double gravity, int iterations, bool inverse_scale) {
   Eigen::MatrixXd A;
   Eigen::VectorXd b;
   buildSystem(R_l_imu, p_l_cam, p_imu_cam, preintegrations, A, b);
+  if (inverse_scale) invertSystem(Eigen::MatrixXd(A), Eigen::VectorXd(b), A, b);
   const int n = static_cast<int>(R_l_imu.size());
   const Eigen::MatrixXd A_g = A.middleCols(3 * n, 3);
-  Eigen::MatrixXd A_r(A.rows(), 3 * n + 3);
+  const Eigen::VectorXd A_s = A.col(3 * n + 3);
+  // Unknowns [v (3n), w (2), s]: the scale last, for its sigma.
+  const int s_col = 3 * n + 2;
+  Eigen::MatrixXd A_r(A.rows(), s_col + 1);
   A_r.leftCols(3 * n) = A.leftCols(3 * n);
-  A_r.col(3 * n + 2) = A.col(3 * n + 3);
   Eigen::Vector3d g0 = g0_in.normalized() * gravity;
   Eigen::VectorXd x;
+  double rel_sigma = std::numeric_limits<double>::infinity();
+  double scale = 0;
   for (int it = 0; it < iterations; ++it) {
-    // g = g0 + B w with w in the tangent plane of the sphere |g| = G (VINS-Mono Sec. V-B-3).
+    // g = g0 + B w with w in the tangent plane of the sphere |g| = G (VINS-Mono Sec. V-B-3). In the inverse scale
+    // h = lambda g = lambda g0 + B w' with w' = lambda w: still linear, g0's share moves into lambda's column.
     const Eigen::Matrix<double, 3, 2> B = tangentBasis(g0);
     A_r.middleCols(3 * n, 2) = A_g * B;
-    x = solveLeastSquares(A_r, b - A_g * g0);
+    Eigen::VectorXd rhs = b;
+    if (inverse_scale) {
+      A_r.col(s_col) = A_s + A_g * g0;
+    } else {
+      A_r.col(s_col) = A_s;
+      rhs -= A_g * g0;
+    }
+    x = solveLeastSquares(A_r, rhs);
+    const double last = x(s_col);
+    if (inverse_scale) x /= last;  // u -> v, w' -> w; the scale is 1 / lambda
     g0 = (g0 + B * x.segment<2>(3 * n)).normalized() * gravity;
+    scale = inverse_scale ? 1 / last : last;
+    // The relative standard error of s equals that of lambda to first order (x as solved: undo the division).
+    if (it + 1 == iterations) {
+      rel_sigma = lastUnknownSigma(A_r, rhs, inverse_scale ? Eigen::VectorXd(x * last) : x) / std::abs(last);
+    }
   }
-  return unpack(x, n, g0);
+  LinearAlignment out = unpack(x, n, g0);
+  out.scale = scale;
+  out.scale_sigma = rel_sigma * std::abs(scale);
+  return out;
 }
 
 namespace {
@@ -266,7 +331,8 @@ AlignmentResult alignVisualInertial(const std::vector<InitFrame>& frames, const 
 
   // (e) Linear alignment, (f) gravity refined on |g| = G, (g) checks.
   const double G = imu_config.gravity;
-  const LinearAlignment coarse = linearAlignment(R_l_imu, p_l_cam, t_bc, pre);
+  const bool inverse = config.inverse_scale;
+  const LinearAlignment coarse = linearAlignment(R_l_imu, p_l_cam, t_bc, pre, inverse);
   const double g_error = std::abs(coarse.g_l.norm() - G);
   if (!coarse.g_l.allFinite() || !(g_error <= config.max_gravity_error)) {
     return refuse(result, "linear alignment: |g| = " + fmt(coarse.g_l.norm()) + " m/s^2 is " + fmt(g_error) +
@@ -276,7 +342,7 @@ AlignmentResult alignVisualInertial(const std::vector<InitFrame>& frames, const 
     return refuse(result, "linear alignment: scale " + fmt(coarse.scale, 4) + " <= " + fmt(config.min_scale, 4));
   }
   const LinearAlignment la =
-      refineGravity(R_l_imu, p_l_cam, t_bc, pre, coarse.g_l, G, config.refine_gravity_iterations);
+      refineGravity(R_l_imu, p_l_cam, t_bc, pre, coarse.g_l, G, config.refine_gravity_iterations, inverse);
   result.scale = la.scale;
   result.gravity_camera_l = la.g_l;
   bool finite = la.g_l.allFinite() && std::isfinite(la.scale);
@@ -286,6 +352,14 @@ AlignmentResult alignVisualInertial(const std::vector<InitFrame>& frames, const 
     return refuse(result, "refine gravity: scale " + fmt(la.scale, 4) + " <= " + fmt(config.min_scale, 4));
   }
 
+  // (g') The scale must be determined: a window that cannot tell a forward acceleration from a tilt of gravity
+  // (a steady acceleration without rotation: a car pulling away) returns a scale off by tens of percent.
+  result.scale_rel_sigma = la.scale_sigma / la.scale;
+  if (!(result.scale_rel_sigma <= config.max_scale_rel_sigma)) {
+    return refuse(result, "refine gravity: scale " + fmt(la.scale, 3) + " not determined, +-" +
+                              fmt(100 * result.scale_rel_sigma, 1) + " % > " + fmt(100 * config.max_scale_rel_sigma, 1) +
+                              " % (too little rotation or change of acceleration to separate them from gravity)");
+  }
   // (h) Gravity-aligned world frame.
   toWorld(R_l_imu, p_l_cam, t_bc, la, sfm, result);
   result.ok = true;

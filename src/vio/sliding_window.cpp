@@ -108,6 +108,10 @@ std::vector<Eigen::Isometry3d> SlidingWindowEstimator::cameraPoses() const {
 
 void SlidingWindowEstimator::reset() {
   init_prior_.active = false;
+  aligned_visually_ = false;
+  history_.clear();
+  history_next_imu_.clear();
+  scale_failure_.clear();
   frames_.clear();
   features_.clear();
   prior_.reset();
@@ -164,6 +168,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
     result.event = why + ": window cleared, re-initialising";
     return result;
   }
+  checkScaleOverHistory(result);  // may rescale the window: this frame's output is then the first of the new scale
   fillResult(result);
   if (config_.relative_covariance) {
     const auto start = std::chrono::steady_clock::now();
@@ -271,7 +276,10 @@ void SlidingWindowEstimator::slide(bool keyframe, FrameResult& result) {
   const bool use_lidar = config_.depth_mode != DepthMode::kOff;
   result.keyframe = keyframe;
   if (keyframe) {
-    if (initialized_) marginalizeOldest();
+    if (initialized_) {
+      recordOldest();
+      marginalizeOldest();
+    }
     const Eigen::Isometry3d T_ic = T_imu_cam();
     features_.removeOldest(frames_[0]->pose() * T_ic, frames_[1]->pose() * T_ic, use_lidar && initialized_);
     frames_.pop_front();

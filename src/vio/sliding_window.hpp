@@ -21,6 +21,7 @@
 #include "imu/preintegration.hpp"
 #include "types/imu.hpp"
 #include "vio/feature_manager.hpp"
+#include "vio/scale_check.hpp"
 #include "vio/vio_config.hpp"
 
 namespace ceres {
@@ -49,6 +50,8 @@ struct FrameResult {
   bool initialized = false;         // the window is initialised and the state below is an estimate
   bool just_initialized = false;
   bool reset = false;               // a failure cleared the window at this frame
+  bool rescaled = false;            // the scale check rescaled and tilted the window before this frame's output:
+                                    // its pose is not continuous with the previous frame's (like an initialisation)
   std::string event;                // why initialisation waits, how it succeeded, or why the window was reset
   bool keyframe = false;            // the second-newest frame was kept (the oldest was marginalised)
   int tracked = 0;                  // features of this frame already in the window
@@ -86,6 +89,8 @@ class SlidingWindowEstimator {
   int windowSize() const { return static_cast<int>(frames_.size()); }
   // Share of the solved features observed in >= 3 window keyframes (the track-length question), last frame.
   double featuresInThreeOrMore() const { return share_three_; }
+  // Scale checks run since construction (vio/scale_check.hpp; only after visual-inertial initialisations).
+  int scaleChecks() const { return scale_checks_; }
   void reset();  // clears everything (a failure, or the caller's reset)
   // Live use: the solver stops at config.max_solver_ms (results then depend on timing). Replay: iterations only.
   void setRealtime(bool realtime) { deterministic_ = !realtime; }
@@ -148,6 +153,17 @@ class SlidingWindowEstimator {
     double p[3], q[4], v[3], bias[6];  // the oldest frame's state at initialisation
   };
   InitPrior init_prior_;
+  // The scale check after a visual initialisation (window_scale_check.cpp): the keyframes that left the window,
+  // each with the IMU from the one before, and the IMU from the newest of them to the window's oldest frame.
+  std::deque<ScaleCheckFrame> history_;
+  std::vector<ImuSample> history_next_imu_;
+  bool aligned_visually_ = false;
+  Time last_scale_check_ = 0;
+  int scale_checks_ = 0;
+  std::string scale_failure_;                  // a check found the scale off beyond repair: failure() says it
+  void recordOldest();                         // before the oldest frame leaves the window
+  void checkScaleOverHistory(FrameResult& result);
+  void applyScale(const ScaleCheck& check);
   void setInitPrior(double sigma_rotation, double sigma_velocity, double sigma_gyro_bias, double sigma_acc_bias);
 };
 

@@ -58,6 +58,12 @@ std::string VioConfig::validate() const {
                        align_sigma_acc_bias})
     if (!positive(sigma)) return "the initialisation sigmas (init_sigma_*, lis_sigma_*, align_sigma_*) must be > 0";
   if (!nonNegative(init_min_acc_excitation)) return "init_min_acc_excitation must be >= 0";
+  if (!positive(init_max_scale_rel_sigma)) return "init_max_scale_rel_sigma must be > 0";
+  if (!nonNegative(scale_check_span_s)) return "scale_check_span_s must be >= 0";
+  if (!positive(scale_check_every_s)) return "scale_check_every_s must be > 0";
+  if (!positive(scale_check_max_rel_sigma)) return "scale_check_max_rel_sigma must be > 0";
+  if (!nonNegative(scale_check_min_change)) return "scale_check_min_change must be >= 0";
+  if (!(scale_check_max_change > 1)) return "scale_check_max_change must be > 1";
   if (min_tracked < 0) return "min_tracked must be >= 0";
   if (!positive(max_imu_gap_s)) return "max_imu_gap_s must be > 0";
   if (!positive(max_acc_bias) || !positive(max_gyro_bias) || !positive(max_jump_m) || !positive(max_height_jump_m) ||

@@ -94,6 +94,7 @@ void SlidingWindowEstimator::marginalizeSecondNewest() {
 std::string SlidingWindowEstimator::failure(const FrameResult& result) const {
   const Frame& f = *frames_.back();
   if (solver_failed_) return "the solver failed";
+  if (!scale_failure_.empty()) return "the window's " + scale_failure_;
   if (!result.just_initialized && result.tracked < config_.min_tracked)
     return fmt::format("only {} features tracked into the frame (< {})", result.tracked, config_.min_tracked);
   const imu::ImuBias b = f.imuBias();

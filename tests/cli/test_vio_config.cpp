@@ -32,6 +32,9 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   time_offset_sigma_s: 0.002
   init: visual
   init_min_acc_excitation: 0.1
+  init_max_scale_rel_sigma: 0.05
+  scale_check_span_s: 20
+  scale_check_max_change: 1.5
   lis_sigma_rotation_rad: 0.02
   seed_max_median_px: 4.5
   seed_min_observations: 40
@@ -48,6 +51,9 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   EXPECT_DOUBLE_EQ(c.time_offset_sigma_s, 0.002);
   EXPECT_EQ(c.init, vio::InitMode::kVisual);
   EXPECT_DOUBLE_EQ(c.init_min_acc_excitation, 0.1);
+  EXPECT_DOUBLE_EQ(c.init_max_scale_rel_sigma, 0.05);
+  EXPECT_DOUBLE_EQ(c.scale_check_span_s, 20);
+  EXPECT_DOUBLE_EQ(c.scale_check_max_change, 1.5);
   EXPECT_DOUBLE_EQ(c.lis_sigma_rotation_rad, 0.02);
   EXPECT_DOUBLE_EQ(c.seed_max_median_px, 4.5);
   EXPECT_EQ(c.seed_min_observations, 40);

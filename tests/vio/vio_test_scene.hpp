@@ -19,7 +19,14 @@
 
 namespace drover::vio::test {
 
-enum class Motion { kExcited, kStill, kRotationOnly, kConstantVelocity };
+enum class Motion {
+  kExcited,
+  kStill,
+  kRotationOnly,
+  kConstantVelocity,
+  kCarPullingAway,  // a car at 8 m/s accelerating at 1 m/s^2, straight; the road shakes it 4 mm up and down
+  kCarInABend,      // the same car braking and accelerating through a bend (yaw 0.3 rad over the window)
+};
 
 struct SceneConfig {
   Motion motion = Motion::kExcited;
@@ -29,6 +36,7 @@ struct SceneConfig {
   Eigen::Vector3d gyro_bias = Eigen::Vector3d(0.01, -0.02, 0.015);  // [rad/s]
   double gravity = 9.81;
   int points = 250;
+  double near_m = 4, far_m = 12;  // [m] the points' distance ahead of the start
   double pixel_noise_px = 0;  // std of the image noise at focal_px
   double focal_px = 460;
   unsigned seed = 7;
@@ -55,13 +63,15 @@ struct Sine {
 };
 
 struct Trajectory {
-  Eigen::Vector3d p0 = Eigen::Vector3d(1, -2, 1.5), v0 = Eigen::Vector3d::Zero();
+  Eigen::Vector3d p0 = Eigen::Vector3d(1, -2, 1.5), v0 = Eigen::Vector3d::Zero(), a0 = Eigen::Vector3d::Zero();
   Sine px, py, pz, roll, pitch, yaw;
   double yaw0 = 0.4;
 
-  Eigen::Vector3d position(double t) const { return p0 + v0 * t + Eigen::Vector3d(px.value(t), py.value(t), pz.value(t)); }
-  Eigen::Vector3d velocity(double t) const { return v0 + Eigen::Vector3d(px.rate(t), py.rate(t), pz.rate(t)); }
-  Eigen::Vector3d acceleration(double t) const { return Eigen::Vector3d(px.accel(t), py.accel(t), pz.accel(t)); }
+  Eigen::Vector3d position(double t) const {
+    return p0 + v0 * t + 0.5 * a0 * t * t + Eigen::Vector3d(px.value(t), py.value(t), pz.value(t));
+  }
+  Eigen::Vector3d velocity(double t) const { return v0 + a0 * t + Eigen::Vector3d(px.rate(t), py.rate(t), pz.rate(t)); }
+  Eigen::Vector3d acceleration(double t) const { return a0 + Eigen::Vector3d(px.accel(t), py.accel(t), pz.accel(t)); }
   // Body rate: vee(R^T dR/dt) with dR/dt from the Euler-angle rates (R = Rz(yaw) Ry(pitch) Rx(roll)).
   Eigen::Vector3d bodyRate(double t) const {
     const Eigen::Matrix3d Rz = Eigen::AngleAxisd(yaw0 + yaw.value(t), Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -108,6 +118,23 @@ inline Trajectory trajectoryFor(Motion motion) {
     case Motion::kConstantVelocity:  // plenty of parallax, but no acceleration: the scale is unobservable
       tr.v0 = Eigen::Vector3d(1.0, 0.2, 0.05);
       break;
+    case Motion::kCarPullingAway: {  // along the start's heading yaw0
+      const Eigen::Vector3d ahead(std::cos(tr.yaw0), std::sin(tr.yaw0), 0);
+      tr.v0 = 8.0 * ahead;
+      tr.a0 = 1.0 * ahead;
+      tr.pz = {0.004, 3.0, 0.0};  // 1.4 m/s^2 of vertical shake: passes VINS-Mono's excitation test
+      break;
+    }
+    case Motion::kCarInABend: {
+      const Eigen::Vector3d ahead(std::cos(tr.yaw0), std::sin(tr.yaw0), 0);
+      tr.v0 = 8.0 * ahead;
+      tr.px = {0.15, 0.6, 0.0};  // +-2.1 and 1.5 m/s^2 along x and y: braking, accelerating, the bend
+      tr.py = {0.15, 0.5, 1.0};
+      tr.pz = {0.004, 3.0, 0.0};
+      tr.yaw = {0.3, 0.3, 0.0};
+      tr.pitch = {0.01, 1.0, 0.5};
+      break;
+    }
   }
   return tr;
 }
@@ -128,7 +155,7 @@ inline Scene makeScene(const SceneConfig& config) {
   scene.T_imu_cam = testImuCam();
   const Trajectory tr = trajectoryFor(config.motion);
   std::mt19937 rng(config.seed);
-  std::uniform_real_distribution<double> ux(4, 12), uy(-6, 6), uz(-3, 4);
+  std::uniform_real_distribution<double> ux(config.near_m, config.far_m), uy(-6, 6), uz(-3, 4);
   std::normal_distribution<double> noise(0, config.pixel_noise_px / config.focal_px);
   std::vector<Eigen::Vector3d>& points = scene.points_world;
   for (int i = 0; i < config.points; ++i) points.push_back(tr.p0 + Eigen::AngleAxisd(tr.yaw0, Eigen::Vector3d::UnitZ()) *

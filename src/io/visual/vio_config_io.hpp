@@ -10,7 +10,9 @@
 //        init_sigma_position_m [m], lis_sigma_rotation_rad / align_sigma_rotation_rad [rad],
 //        lis_sigma_velocity / align_sigma_velocity [m/s], lis_sigma_gyro_bias / align_sigma_gyro_bias [rad/s],
 //        lis_sigma_acc_bias / align_sigma_acc_bias [m/s^2], seed_max_median_px [px], seed_min_observations,
-//        init_min_acc_excitation [m/s^2], min_tracked, max_acc_bias [m/s^2], max_gyro_bias [rad/s],
+//        init_min_acc_excitation [m/s^2], init_max_scale_rel_sigma,
+//        scale_check_span_s [s], scale_check_every_s [s], scale_check_max_rel_sigma, scale_check_min_change,
+//        scale_check_max_change, min_tracked, max_acc_bias [m/s^2], max_gyro_bias [rad/s],
 //        max_jump_m [m], max_height_jump_m [m], max_turn_deg [deg], max_speed [m/s], max_imu_gap_s [s]
 #include <string>
 
