@@ -357,8 +357,9 @@ AlignmentResult alignVisualInertial(const std::vector<InitFrame>& frames, const 
   result.scale_rel_sigma = la.scale_sigma / la.scale;
   if (!(result.scale_rel_sigma <= config.max_scale_rel_sigma)) {
     return refuse(result, "refine gravity: scale " + fmt(la.scale, 3) + " not determined, +-" +
-                              fmt(100 * result.scale_rel_sigma, 1) + " % > " + fmt(100 * config.max_scale_rel_sigma, 1) +
-                              " % (too little rotation or change of acceleration to separate them from gravity)");
+                              fmt(100 * result.scale_rel_sigma, 1) + " % > " +
+                              fmt(100 * config.max_scale_rel_sigma, 1) +
+                              " % (too little rotation or change of acceleration to tell acceleration from gravity)");
   }
   // (h) Gravity-aligned world frame.
   toWorld(R_l_imu, p_l_cam, t_bc, la, sfm, result);

@@ -38,7 +38,8 @@ struct ScaleCheck {
   std::vector<Eigen::Vector3d> v_world;  // [m/s] per frame, corrected world frame
 };
 
-// Throws std::invalid_argument when a frame's IMU does not cover its interval. gravity: |g| [m/s^2].
+// Gravity's magnitude from imu_config. Fewer than 3 frames: ok = false. Throws std::invalid_argument when a frame's
+// IMU does not cover its interval.
 ScaleCheck checkScale(const std::vector<ScaleCheckFrame>& frames, const Eigen::Isometry3d& T_imu_cam,
                       const imu::PreintegrationConfig& imu_config);
 

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "backend/schur_marginalizer.hpp"
+#include "backend/schur_marginalizer.hpp"  // the marginal prior's type, complete for its reset
 #include "vio/window_frame.hpp"
 
 namespace drover::vio {
@@ -52,8 +52,9 @@ void SlidingWindowEstimator::checkScaleOverHistory(FrameResult& result) {
 }
 
 // Scale about the newest frame's camera (kept, so the output does not jump) and tilt by R_fix: a monocular
-// window's error is in its camera positions (and depths); the IMU follows at the metric lever arm. The marginal prior was linearised at the old scale: it is replaced by
-// the initialisation's prior on the oldest frame, with the velocity sigma widened by the check's uncertainty.
+// window's error is in its camera positions (and depths); the IMU follows at the metric lever arm. The marginal
+// prior was linearised at the old scale: it is replaced by the initialisation's prior on the oldest frame, with the
+// velocity sigma widened by the check's uncertainty.
 void SlidingWindowEstimator::applyScale(const ScaleCheck& check) {
   const Eigen::Isometry3d T_ic = T_imu_cam();
   const Eigen::Vector3d pivot = (frames_.back()->pose() * T_ic).translation();

@@ -57,7 +57,9 @@ TEST(ScaleCheck, FindsTheScaleAndTheTiltOfATrajectoryThatHasThemWrong) {
   EXPECT_LT(check.rel_sigma, 1e-3);
   // The velocities in the corrected world: the truth's, up to the yaw the check leaves alone (none here).
   ASSERT_EQ(check.v_world.size(), scene.v_world.size());
-  for (std::size_t k = 0; k < scene.v_world.size(); ++k) EXPECT_LT((check.v_world[k] - scene.v_world[k]).norm(), 0.01) << k;
+  for (std::size_t k = 0; k < scene.v_world.size(); ++k) {
+    EXPECT_LT((check.v_world[k] - scene.v_world[k]).norm(), 0.01) << k;
+  }
 }
 
 TEST(ScaleCheck, ARightTrajectoryIsLeftAlone) {
