@@ -87,7 +87,10 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  window: 2\n", "window must be in [3, 50]"},
            {"vio:\n  sigma_px: -1\n", "sigma_px must be > 0"},
            {"vio:\n  max_time_offset_s: nan\n", "vio.max_time_offset_s"},
-           {"vio:\n  relative_covariance: often\n", "vio.relative_covariance"}}) {
+           {"vio:\n  relative_covariance: often\n", "vio.relative_covariance"},
+           {"vio:\n  init_max_scale_rel_sigma: 0\n", "init_max_scale_rel_sigma must be > 0"},
+           {"vio:\n  scale_check_span_s: -5\n", "scale_check_span_s must be >= 0"},
+           {"vio:\n  scale_check_max_change: 1\n", "scale_check_max_change must be > 1"}}) {
     SCOPED_TRACE(yaml);
     const std::string path = write(dir, yaml);
     test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", "line", words});
