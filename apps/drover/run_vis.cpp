@@ -145,6 +145,12 @@ void RunVis::record(const vio::VisFrame& f) {
   } else if (!r.initialized && !r.event.empty()) {
     waiting_ = r.event;
   }
+  if (r.coasting && !coasting_) {  // one event per stretch; the frames are counted
+    spdlog::info("VIS at {:.3f} s: {}", toSeconds(r.t), r.event);
+    if (events_.size() < kMaxEvents) events_.push_back({r.t, "coasting", r.event});
+  }
+  coasting_ = r.coasting;
+  coasted_ += r.coasting ? 1 : 0;
   new_state_ = states_.onFrame(r);
   if (r.initialized) trajectory_.push_back({r.t, r.T_world_imu});
   records_.push_back({r.t, r.initialized, r.keyframe, f.detected, f.front_tracked, r.features, r.with_lidar_depth,
@@ -170,6 +176,7 @@ Json RunVis::report() const {
   if (!first_init_) j["not_initialized_because"] = waiting_;
   j["resets"] = resets_;
   j["rescales"] = rescales_;
+  j["frames_coasted"] = coasted_;
   j["scale_checks"] = vo_ != nullptr ? vo_->estimator().scaleChecks() : 0;
   j["time_offset_s"] = vo_ != nullptr ? vo_->estimator().timeOffset() : 0.0;
   Json events = Json::array();

@@ -88,7 +88,8 @@ class RunVis {
   std::vector<Event> events_;        // initialisations and resets (and the last "waiting" reason)
   std::string waiting_;              // why the VIS has not initialised yet (the newest reason)
   std::optional<pipeline::ScanOutcome> lis_state_;
-  std::size_t frames_in_ = 0, frames_bad_ = 0, resets_ = 0, rescales_ = 0;
+  std::size_t frames_in_ = 0, frames_bad_ = 0, resets_ = 0, rescales_ = 0, coasted_ = 0;
+  bool coasting_ = false;  // the previous frame coasted (vio::FrameResult::coasting)
   std::optional<Time> first_init_;
   pipeline::VisualStateStream states_;
   std::optional<pipeline::VisualState> new_state_;

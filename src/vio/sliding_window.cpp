@@ -108,6 +108,7 @@ std::vector<Eigen::Isometry3d> SlidingWindowEstimator::cameraPoses() const {
 
 void SlidingWindowEstimator::reset() {
   init_prior_.active = false;
+  coasting_since_.reset();
   aligned_visually_ = false;
   history_.clear();
   history_next_imu_.clear();
@@ -161,6 +162,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
   }
   optimize(result);
   removeOutliers(result);
+  checkCoasting(result, static_cast<bool>(seed));
   if (const std::string why = failure(result); !why.empty()) {
     reset();
     result.reset = true;

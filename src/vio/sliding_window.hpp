@@ -8,7 +8,8 @@
 // failure checks run, and one frame leaves the window by marginalisation: the oldest when the second-newest frame
 // is a keyframe (enough parallax or few tracked features), else the second-newest (its IMU folded into the next).
 // Before initialisation the window fills and slides without marginalisation; initialisation is from an external
-// seed (the LIS: poses, velocities and biases at the frames' stamps) or visual-inertial alignment (Sec. V).
+// seed (the LIS: poses, velocities and biases at the frames' stamps) or visual-inertial alignment (Sec. V). Without a
+// LIS, a window that loses its tracks coasts on the IMU for a while instead of being cleared.
 // Deterministic: no wall-clock limit unless config.max_solver_ms applies (live use), single-threaded solver.
 #include <Eigen/Geometry>
 #include <deque>
@@ -49,6 +50,7 @@ struct FrameResult {
   Time t = 0;                       // [ns] the frame's stamp in IMU time (with the estimated td)
   bool initialized = false;         // the window is initialised and the state below is an estimate
   bool just_initialized = false;
+  bool coasting = false;            // too few features tracked and no LIS: the window goes on on the IMU
   bool reset = false;               // a failure cleared the window at this frame
   bool rescaled = false;            // the scale check rescaled and tilted the window before this frame's output:
                                     // its pose is not continuous with the previous frame's (like an initialisation)
@@ -109,7 +111,10 @@ class SlidingWindowEstimator {
   void optimize(FrameResult& result);
   void buildResiduals(Residuals& r, bool for_marginalization_of_oldest) const;
   void removeOutliers(FrameResult& result);
-  std::string failure(const FrameResult& previous_output) const;
+  // Why the window failed (empty: it did not). Too few tracked features are one reason unless result.coasting.
+  std::string failure(const FrameResult& result) const;
+  // Without a LIS, too few tracked features for up to vio.coast_max_s do not clear the window: sets result.coasting.
+  void checkCoasting(FrameResult& result, bool has_seed);
   void slide(bool keyframe, FrameResult& result);
   void declareWindowBlocks(backend::SchurMarginalizer& m);
   // declareWindowBlocks, then the window's residuals (buildResiduals) and their feature blocks declared in the
@@ -165,6 +170,8 @@ class SlidingWindowEstimator {
   void checkScaleOverHistory(FrameResult& result);
   void applyScale(const ScaleCheck& check);
   void setInitPrior(double sigma_rotation, double sigma_velocity, double sigma_gyro_bias, double sigma_acc_bias);
+  // Coasting (no LIS; vio.coast_max_s): since when the newest frames have had too few tracked features.
+  std::optional<Time> coasting_since_;
 };
 
 }  // namespace drover::vio

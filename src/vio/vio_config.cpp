@@ -65,6 +65,7 @@ std::string VioConfig::validate() const {
   if (!nonNegative(scale_check_min_change)) return "scale_check_min_change must be >= 0";
   if (!(scale_check_max_change > 1)) return "scale_check_max_change must be > 1";
   if (min_tracked < 0) return "min_tracked must be >= 0";
+  if (!nonNegative(coast_max_s)) return "coast_max_s must be >= 0 (0: no coasting)";
   if (!positive(max_imu_gap_s)) return "max_imu_gap_s must be > 0";
   if (!positive(max_acc_bias) || !positive(max_gyro_bias) || !positive(max_jump_m) || !positive(max_height_jump_m) ||
       !positive(max_turn_deg) || !positive(max_speed))

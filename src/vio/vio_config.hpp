@@ -81,7 +81,9 @@ struct VioConfig {
   double scale_check_min_change = 0.02;
   double scale_check_max_change = 2.0;
   // Failure detection (VINS-Mono failureDetection).
-  int min_tracked = 8;             // fewer features tracked into the newest frame: failure
+  int min_tracked = 8;             // fewer features tracked into the newest frame: failure (with a LIS to seed it
+                                   // again; alone, after coast_max_s)
+  double coast_max_s = 30;         // [s] alone, a window with too few tracks goes on on the IMU this long (0: never)
   double max_acc_bias = 2.5;       // [m/s^2]
   double max_gyro_bias = 1.0;      // [rad/s]
   double max_jump_m = 5.0;         // [m] position change between consecutive frames

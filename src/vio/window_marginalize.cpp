@@ -90,13 +90,36 @@ void SlidingWindowEstimator::marginalizeSecondNewest() {
   else prior_.reset();
 }
 
+// VINS-Mono does not clear its window for a few tracked features (the check is commented out); LVI-SAM clears it and
+// starts again from the LIS. Drover does the latter when a LIS seeds the VIS. Alone, a cleared window must wait for a
+// new visual-inertial alignment, which needs acceleration a robot crossing a dark shed at constant speed never gives
+// it; and a window started afresh forgets what its marginal prior knew of the biases and the tilt, which at constant
+// speed is all that holds the scale. So alone it coasts: the IMU and whatever tracks remain carry the window.
+void SlidingWindowEstimator::checkCoasting(FrameResult& result, bool has_seed) {
+  const bool few = !result.just_initialized && result.tracked < config_.min_tracked;
+  if (!few) {
+    coasting_since_.reset();
+    return;
+  }
+  if (has_seed || !(config_.coast_max_s > 0)) return;
+  if (!coasting_since_) coasting_since_ = last_output_ ? last_output_->t : result.t;
+  if (toSeconds(result.t - *coasting_since_) > config_.coast_max_s) return;  // failure() clears the window
+  result.coasting = true;
+  result.event = fmt::format("coasting on the IMU: only {} features tracked into the frame (< {}) for {:.2f} s",
+                             result.tracked, config_.min_tracked, toSeconds(result.t - *coasting_since_));
+}
+
 // VINS-Mono failureDetection, plus a solver failure and an implausible time offset. Empty when healthy.
 std::string SlidingWindowEstimator::failure(const FrameResult& result) const {
   const Frame& f = *frames_.back();
   if (solver_failed_) return "the solver failed";
   if (!scale_failure_.empty()) return "the window's " + scale_failure_;
-  if (!result.just_initialized && result.tracked < config_.min_tracked)
+  if (!result.just_initialized && result.tracked < config_.min_tracked && !result.coasting) {
+    if (coasting_since_)
+      return fmt::format("only {} features tracked into the frame (< {}) for {:.1f} s", result.tracked,
+                         config_.min_tracked, toSeconds(result.t - *coasting_since_));
     return fmt::format("only {} features tracked into the frame (< {})", result.tracked, config_.min_tracked);
+  }
   const imu::ImuBias b = f.imuBias();
   if (!b.acc.allFinite() || !f.pose().matrix().allFinite() || !f.velocity().allFinite()) return "non-finite state";
   if (b.acc.norm() > config_.max_acc_bias)

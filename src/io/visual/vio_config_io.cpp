@@ -70,6 +70,7 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
       .bind("scale_check_min_change", c.scale_check_min_change)
       .bind("scale_check_max_change", c.scale_check_max_change)
       .bind("min_tracked", c.min_tracked)
+      .bind("coast_max_s", c.coast_max_s)
       .bind("max_acc_bias", c.max_acc_bias)
       .bind("max_gyro_bias", c.max_gyro_bias)
       .bind("max_jump_m", c.max_jump_m)
