@@ -32,7 +32,11 @@ struct ScaleCheck {
   bool ok = false;
   std::string why;                 // when not ok: which step failed, with its numbers
   double scale = 1;                // metric / estimated: multiply the VIS's distances and speeds by it
-  double rel_sigma = 0;            // relative standard error of scale (from the residuals)
+  double rel_sigma = 0;            // relative standard error of scale (from the residuals, white noise)
+  double acc_std = 0;              // [m/s^2] std of the world-frame acceleration over the keyframe intervals: the
+                                   // signal the scale is measured by (an unmodelled accelerometer bias error b
+                                   // rotating with the body errs the scale by up to b / acc_std, which the
+                                   // residuals do not show)
   Eigen::Matrix3d R_fix = Eigen::Matrix3d::Identity();  // rotates the estimated world so gravity is -z
   double tilt_rad = 0;             // angle of R_fix [rad]
   std::vector<Eigen::Vector3d> v_world;  // [m/s] per frame, corrected world frame

@@ -168,7 +168,7 @@ class SlidingWindowEstimator {
   std::string scale_failure_;                  // a check found the scale off beyond repair: failure() says it
   void recordOldest();                         // before the oldest frame leaves the window
   void checkScaleOverHistory(FrameResult& result);
-  void applyScale(const ScaleCheck& check);
+  void applyScale(const ScaleCheck& check, double rel_sigma);  // rel_sigma: the scale's, bias error included
   void setInitPrior(double sigma_rotation, double sigma_velocity, double sigma_gyro_bias, double sigma_acc_bias);
   // Coasting (no LIS; vio.coast_max_s): since when the newest frames have had too few tracked features.
   std::optional<Time> coasting_since_;

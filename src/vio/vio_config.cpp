@@ -64,6 +64,7 @@ std::string VioConfig::validate() const {
   if (!positive(scale_check_max_rel_sigma)) return "scale_check_max_rel_sigma must be > 0";
   if (!nonNegative(scale_check_min_change)) return "scale_check_min_change must be >= 0";
   if (!(scale_check_max_change > 1)) return "scale_check_max_change must be > 1";
+  if (!nonNegative(scale_check_bias_sigma)) return "scale_check_bias_sigma must be >= 0";
   if (min_tracked < 0) return "min_tracked must be >= 0";
   if (!nonNegative(coast_max_s)) return "coast_max_s must be >= 0 (0: no coasting)";
   if (!positive(max_imu_gap_s)) return "max_imu_gap_s must be > 0";

@@ -80,6 +80,8 @@ struct VioConfig {
   double scale_check_max_rel_sigma = 0.03;
   double scale_check_min_change = 0.02;
   double scale_check_max_change = 2.0;
+  double scale_check_bias_sigma = 0.02;  // [m/s^2] the accelerometer bias error the check does not estimate: its
+                                         // scale sigma adds this over the span's acceleration std
   // Failure detection (VINS-Mono failureDetection).
   int min_tracked = 8;             // fewer features tracked into the newest frame: failure (with a LIS to seed it
                                    // again; alone, after coast_max_s)

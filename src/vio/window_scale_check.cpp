@@ -35,18 +35,25 @@ void SlidingWindowEstimator::checkScaleOverHistory(FrameResult& result) {
   const std::vector<ScaleCheckFrame> frames(history_.begin(), history_.end());
   const ScaleCheck check = checkScale(frames, T_imu_cam(), imu_config_);
   ++scale_checks_;
-  if (!check.ok || !(check.rel_sigma <= config_.scale_check_max_rel_sigma)) return;
+  if (!check.ok) return;
+  // The residuals' sigma assumes white noise; an accelerometer bias error of scale_check_bias_sigma errs the scale by
+  // up to that over the acceleration's std (tests/vio/test_scale_check.cpp). kitti05-replay's 15 s spans have
+  // 0.5-2.1 m/s^2: 1-4 % at 0.02 m/s^2. The farm's uphill course 0.18 m/s^2 in its first span and 0.011-0.016 later:
+  // the residuals claimed x0.979 +-0.2 % and x1.298 +-2.8 % there, where the scale was right to 2 %.
+  const double sigma = std::hypot(check.rel_sigma, config_.scale_check_bias_sigma / check.acc_std);
+  if (!(sigma <= config_.scale_check_max_rel_sigma)) return;
   const double change = std::abs(std::log(check.scale));
-  if (change < std::max(std::log1p(config_.scale_check_min_change), 2 * check.rel_sigma)) return;
-  const std::string what =
-      fmt::format("scale x{:.3f} +- {:.1f} % and tilt {:.2f} deg against the IMU over {:.1f} s of keyframes",
-                  check.scale, 100 * check.rel_sigma, check.tilt_rad * 180 / M_PI,
-                  toSeconds(history_.back().t - history_.front().t));
+  if (change < std::max(std::log1p(config_.scale_check_min_change), 2 * sigma)) return;
+  const std::string what = fmt::format(
+      "scale x{:.3f} +- {:.1f} % (residuals {:.1f} %, acceleration std {:.2f} m/s^2) and tilt {:.2f} deg against the "
+      "IMU over {:.1f} s of keyframes",
+      check.scale, 100 * sigma, 100 * check.rel_sigma, check.acc_std, check.tilt_rad * 180 / M_PI,
+      toSeconds(history_.back().t - history_.front().t));
   if (change > std::log(config_.scale_check_max_change)) {
     scale_failure_ = what;  // failure() clears the window at the next frame
     return;
   }
-  applyScale(check);
+  applyScale(check, sigma);
   result.rescaled = true;
   result.event += (result.event.empty() ? "" : "; ") + what;
 }
@@ -55,7 +62,7 @@ void SlidingWindowEstimator::checkScaleOverHistory(FrameResult& result) {
 // window's error is in its camera positions (and depths); the IMU follows at the metric lever arm. The marginal
 // prior was linearised at the old scale: it is replaced by the initialisation's prior on the oldest frame, with the
 // velocity sigma widened by the check's uncertainty.
-void SlidingWindowEstimator::applyScale(const ScaleCheck& check) {
+void SlidingWindowEstimator::applyScale(const ScaleCheck& check, double rel_sigma) {
   const Eigen::Isometry3d T_ic = T_imu_cam();
   const Eigen::Vector3d pivot = (frames_.back()->pose() * T_ic).translation();
   for (auto& f : frames_) {
@@ -69,7 +76,7 @@ void SlidingWindowEstimator::applyScale(const ScaleCheck& check) {
   for (auto& [id, feature] : features_.features())
     if (feature.depth > 0 && !feature.lidar_anchor) feature.depth *= check.scale;
   prior_.reset();
-  const double speed_error = check.rel_sigma * frames_.front()->velocity().norm();
+  const double speed_error = rel_sigma * frames_.front()->velocity().norm();
   setInitPrior(config_.align_sigma_rotation_rad, std::hypot(config_.align_sigma_velocity, speed_error),
                config_.align_sigma_gyro_bias, config_.align_sigma_acc_bias);
   history_.clear();  // the next check measures the corrected trajectory only

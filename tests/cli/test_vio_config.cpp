@@ -36,6 +36,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   scale_check_span_s: 20
   scale_check_max_change: 1.5
   coast_max_s: 12
+  scale_check_bias_sigma: 0.05
   lis_sigma_rotation_rad: 0.02
   seed_max_median_px: 4.5
   seed_min_observations: 40
@@ -56,6 +57,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   EXPECT_DOUBLE_EQ(c.scale_check_span_s, 20);
   EXPECT_DOUBLE_EQ(c.scale_check_max_change, 1.5);
   EXPECT_DOUBLE_EQ(c.coast_max_s, 12);
+  EXPECT_DOUBLE_EQ(c.scale_check_bias_sigma, 0.05);
   EXPECT_DOUBLE_EQ(c.lis_sigma_rotation_rad, 0.02);
   EXPECT_DOUBLE_EQ(c.seed_max_median_px, 4.5);
   EXPECT_EQ(c.seed_min_observations, 40);
@@ -93,7 +95,8 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  init_max_scale_rel_sigma: 0\n", "init_max_scale_rel_sigma must be > 0"},
            {"vio:\n  scale_check_span_s: -5\n", "scale_check_span_s must be >= 0"},
            {"vio:\n  scale_check_max_change: 1\n", "scale_check_max_change must be > 1"},
-           {"vio:\n  coast_max_s: -1\n", "coast_max_s must be >= 0"}}) {
+           {"vio:\n  coast_max_s: -1\n", "coast_max_s must be >= 0"},
+           {"vio:\n  scale_check_bias_sigma: -0.1\n", "scale_check_bias_sigma must be >= 0"}}) {
     SCOPED_TRACE(yaml);
     const std::string path = write(dir, yaml);
     test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", "line", words});

@@ -2,6 +2,8 @@
 // IMU of a car driving through bends for 15 s.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "geometry/so3.hpp"
@@ -86,6 +88,42 @@ TEST(ScaleCheck, AtConstantVelocityTheScaleIsReportedUndetermined) {
   const ScaleCheck check = checkScale(estimated(scene, 0.8, 0.0, 0.02), test::testImuCam(), {});
   if (check.ok) {
     EXPECT_GT(check.rel_sigma, 0.1) << "scale " << check.scale;
+  }
+}
+
+// The check's signal: the world-frame acceleration's std over the keyframe intervals, as the truth has it.
+TEST(ScaleCheck, ReportsTheAccelerationStdItMeasuresTheScaleBy) {
+  const test::Scene bend = drive(test::Motion::kCarInABend);
+  std::vector<Eigen::Vector3d> a;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t k = 1; k < bend.v_world.size(); ++k) {
+    a.push_back((bend.v_world[k] - bend.v_world[k - 1]) / toSeconds(bend.frames[k].t - bend.frames[k - 1].t));
+    mean += a.back() / static_cast<double>(bend.v_world.size() - 1);
+  }
+  double var = 0;
+  for (const Eigen::Vector3d& x : a) var += (x - mean).squaredNorm() / static_cast<double>(a.size());
+  const ScaleCheck check = checkScale(estimated(bend, 1.0, 0.0), test::testImuCam(), {});
+  ASSERT_TRUE(check.ok) << check.why;
+  EXPECT_GT(check.acc_std, 0.3);
+  EXPECT_NEAR(check.acc_std, std::sqrt(var), 0.02 * std::sqrt(var));
+  const test::Scene steady = drive(test::Motion::kConstantVelocity);
+  const ScaleCheck still = checkScale(estimated(steady, 1.0, 0.0), test::testImuCam(), {});
+  EXPECT_LT(still.acc_std, 0.01);
+}
+
+// What the window's vio.scale_check_bias_sigma stands for: an accelerometer bias error the check does not estimate
+// errs the scale by up to the error over the acceleration's std (here, in a bend, the tilt takes most of it).
+TEST(ScaleCheck, AnUnmodelledAccelerometerBiasErrsTheScaleByLessThanItOverTheAccelerationStd) {
+  const test::Scene scene = drive(test::Motion::kCarInABend);
+  const double bias_error = 0.1;  // [m/s^2]
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<ScaleCheckFrame> frames = estimated(scene, 1.0, 0.0);
+    for (ScaleCheckFrame& f : frames) f.bias.acc = bias_error * Eigen::Vector3d::Unit(axis);  // the IMU has none
+    const ScaleCheck check = checkScale(frames, test::testImuCam(), {});
+    ASSERT_TRUE(check.ok) << check.why;
+    std::printf("bias error on axis %d: scale %.4f +- %.4f (residuals), acceleration std %.3f m/s^2\n", axis,
+                check.scale, check.rel_sigma, check.acc_std);
+    EXPECT_LT(std::abs(check.scale - 1.0), bias_error / check.acc_std) << "axis " << axis;
   }
 }
 

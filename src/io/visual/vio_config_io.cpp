@@ -69,6 +69,7 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
       .bind("scale_check_max_rel_sigma", c.scale_check_max_rel_sigma)
       .bind("scale_check_min_change", c.scale_check_min_change)
       .bind("scale_check_max_change", c.scale_check_max_change)
+      .bind("scale_check_bias_sigma", c.scale_check_bias_sigma)
       .bind("min_tracked", c.min_tracked)
       .bind("coast_max_s", c.coast_max_s)
       .bind("max_acc_bias", c.max_acc_bias)
