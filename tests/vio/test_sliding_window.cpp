@@ -209,7 +209,7 @@ TEST(SlidingWindow, WithoutASeedItInitialisesByVisualInertialAlignmentAtMetricSc
 TEST(SlidingWindow, AfterAVisualInitialisationTheScaleCheckRunsAndLeavesARightScaleAlone) {
   const WindowScene scene;
   VioConfig c = config();
-  c.scale_check_span_s = 15;  // off by default
+  c.scale_check_span_s = 15;  // the default; said here because the test depends on it
   SlidingWindowEstimator est(c, imuConfig(), scene.T_imu_cam, 460);
   WindowRun run(scene);
   std::optional<FrameResult> previous;
