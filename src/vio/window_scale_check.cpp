@@ -39,7 +39,7 @@ void SlidingWindowEstimator::checkScaleOverHistory(FrameResult& result) {
   // The residuals' sigma assumes white noise; an accelerometer bias error of scale_check_bias_sigma errs the scale by
   // up to that over the acceleration's std (tests/vio/test_scale_check.cpp). kitti05-replay's 15 s spans have
   // 0.5-2.1 m/s^2: 0.5-2 % at 0.01 m/s^2. The farm's uphill course 0.18 m/s^2 in its first span and 0.011-0.016 later:
-  // the residuals claimed x0.979 +-0.2 % and x1.298 +-2.8 % there, where the scale was right to 2 %.
+  // the residuals claimed x0.979 +-0.2 % (seed 1) and x1.298 +-2.8 % (seed 3) there, for a scale right to 2 %.
   const double sigma = std::hypot(check.rel_sigma, config_.scale_check_bias_sigma / check.acc_std);
   if (!(sigma <= config_.scale_check_max_rel_sigma)) return;
   const double change = std::abs(std::log(check.scale));
