@@ -149,17 +149,19 @@ std::vector<imu::Preintegrator> preintegrateWindow(const std::vector<InitFrame>&
 }
 
 double accelerationExcitation(const std::vector<imu::Preintegrator>& preintegrations) {
-  if (preintegrations.size() < 2) return 0;
   std::vector<Eigen::Vector3d> a;
+  for (const auto& p : preintegrations) a.push_back(p.deltaV() / p.deltaTime());
+  return spreadAboutMean(a);
+}
+
+double spreadAboutMean(const std::vector<Eigen::Vector3d>& values) {
+  if (values.size() < 2) return 0;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : preintegrations) {
-    a.push_back(p.deltaV() / p.deltaTime());
-    mean += a.back();
-  }
-  mean /= static_cast<double>(a.size());
+  for (const auto& x : values) mean += x;
+  mean /= static_cast<double>(values.size());
   double var = 0;
-  for (const auto& x : a) var += (x - mean).squaredNorm();
-  return std::sqrt(var / static_cast<double>(a.size()));
+  for (const auto& x : values) var += (x - mean).squaredNorm();
+  return std::sqrt(var / static_cast<double>(values.size()));
 }
 
 Eigen::Vector3d solveGyroscopeBias(const std::vector<Eigen::Matrix3d>& R_l_imu,

@@ -87,6 +87,8 @@ std::vector<imu::Preintegrator> preintegrateWindow(const std::vector<InitFrame>&
 
 // Standard deviation [m/s^2] of dv_k / dt_k over the window (VINS-Mono initialStructure's excitation check).
 double accelerationExcitation(const std::vector<imu::Preintegrator>& preintegrations);
+// The root-mean-square distance of the vectors from their mean (their spread; 0 for fewer than two).
+double spreadAboutMean(const std::vector<Eigen::Vector3d>& values);
 
 // Gyroscope-bias correction (VINS-Mono solveGyroscopeBias, Eq. 9 with Forster's first-order correction): the
 // least-squares dbg minimising sum |Log(dR_k^T R_bk^T R_bk+1) - dR/dbg_k dbg|^2, R_bk the SfM IMU rotations.

@@ -35,15 +35,11 @@ ScaleCheck checkScale(const std::vector<ScaleCheckFrame>& frames, const Eigen::I
   // The estimate's world is already gravity-aligned to within the error sought: refine from -z directly.
   const double G = imu_config.gravity;
   std::vector<Eigen::Vector3d> acc;  // [m/s^2] world frame: v_k = v_k-1 + g dt + R_k-1 dV
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (std::size_t k = 0; k < pre.size(); ++k) {
+  for (std::size_t k = 0; k < pre.size(); ++k)
     acc.push_back(R[k] * pre[k].deltaV() / pre[k].deltaTime() + Eigen::Vector3d(0, 0, -G));
-    mean += acc.back() / static_cast<double>(pre.size());
-  }
-  double var = 0;
-  for (const Eigen::Vector3d& a : acc) var += (a - mean).squaredNorm() / static_cast<double>(acc.size());
-  out.acc_std = std::sqrt(var);
-  const LinearAlignment la = refineGravity(R, c, T_imu_cam.translation(), pre, Eigen::Vector3d(0, 0, -G), G, 4, true);
+  out.acc_std = spreadAboutMean(acc);
+  const LinearAlignment la = refineGravity(R, c, T_imu_cam.translation(), pre, Eigen::Vector3d(0, 0, -G), G,
+                                           AlignmentConfig{}.refine_gravity_iterations, true);
   out.scale = la.scale;
   out.rel_sigma = la.scale_sigma / la.scale;
   if (!std::isfinite(la.scale) || !(la.scale > 0) || !la.g_l.allFinite() || !std::isfinite(out.rel_sigma)) {
