@@ -113,9 +113,12 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
     if (config_.depth_mode == DepthMode::kFixed) {
       r.fixed_depths.insert(&f->inverse_depth);
     } else if (config_.depth_mode == DepthMode::kFactor) {
-      const double sigma = config_.depth_sigma_m + config_.depth_sigma_rel * f->depth +
+      // The measurement is the lidar's depth at the anchor, not f->depth: that is the last solve's estimate, and a
+      // factor towards it would only resist change from frame to frame, letting the depth (and the window's scale)
+      // walk away from the lidar over the feature's life.
+      const double sigma = config_.depth_sigma_m + config_.depth_sigma_rel * oi.lidar_depth +
                            config_.depth_sigma_spread * oi.depth_spread;
-      r.items.push_back({std::make_unique<backend::InverseDepthFactor>(f->depth, sigma), nullptr,
+      r.items.push_back({std::make_unique<backend::InverseDepthFactor>(oi.lidar_depth, sigma), nullptr,
                          {&f->inverse_depth}});
     }
   }
