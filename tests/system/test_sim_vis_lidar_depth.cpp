@@ -40,7 +40,7 @@ VisDrift visDrift(const test::FusedRun& r, const Trajectory& truth) {
   return d;
 }
 
-TEST(SimVisLidarDepth, DepthsAsFactorsHoldTheVisScaleOnAConstantSpeedDescentAsHeldDepthsDo) {
+TEST(SimVisLidarDepth, DepthsAsFactorsHoldTheVisScaleOnAConstantSpeedDescentWithinTwoPercent) {
   const test::LiveCourse course = test::simulateLiveCourse("downhill", 40, 1, true);
   const auto mode = [](vio::DepthMode m) { return [m](vio::VioConfig& c) { c.depth_mode = m; }; };
   const test::FusedRun factor = runFused(course, 0, true, {}, mode(vio::DepthMode::kFactor));
