@@ -6,37 +6,32 @@
 // and the VIS drifted 4.1 % here (the depths held fixed 1.55 %, no lidar depth 5.8 %).
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cstdio>
 
+#include "eval/association.hpp"
 #include "support/fused_run.hpp"
 
 namespace drover {
 namespace {
-
-// The truth's pose nearest to t (the truth is at 200 Hz, the camera at 15 Hz: at most 2.5 ms apart).
-const Eigen::Isometry3d& nearestTruth(const Trajectory& truth, Time t) {
-  auto it = std::lower_bound(truth.begin(), truth.end(), t, [](const StampedPose& p, Time x) { return p.t < x; });
-  if (it == truth.end()) return truth.back().T_world_body;
-  if (it != truth.begin() && t - std::prev(it)->t < it->t - t) --it;
-  return it->T_world_body;
-}
 
 struct VisDrift {
   double path = 0;       // [m] of the truth over the VIS's estimates
   double end_error = 0;  // [m] after aligning the VIS's first pose on the truth's
 };
 
-// The drift as bench/eval_vis.sh measures it (tools/course_report.py on trajectory_vis.tum).
+// The drift as bench/eval_vis.sh measures it (tools/course_report.py on trajectory_vis.tum): the VIS's poses matched
+// to the truth's nearest stamps (the truth at 200 Hz, the camera at 15 Hz: at most 2.5 ms apart).
 VisDrift visDrift(const test::FusedRun& r, const Trajectory& truth) {
   VisDrift d;
-  if (r.vis.size() < 2) return d;
-  const Eigen::Isometry3d T_truth_est = nearestTruth(truth, r.vis.front().t) * r.vis.front().T_world_body.inverse();
-  for (std::size_t i = 1; i < truth.size(); ++i)
-    if (truth[i].t > r.vis.front().t && truth[i].t <= r.vis.back().t)
-      d.path += (truth[i].T_world_body.translation() - truth[i - 1].T_world_body.translation()).norm();
-  d.end_error = ((T_truth_est * r.vis.back().T_world_body).translation() -
-                 nearestTruth(truth, r.vis.back().t).translation()).norm();
+  const eval::Association a = eval::associate(r.vis, truth);
+  if (a.size() < 2) return d;
+  const StampedPose& vis_first = r.vis[a.first.front()];
+  const StampedPose& vis_last = r.vis[a.first.back()];
+  const Eigen::Isometry3d T_truth_est = truth[a.second.front()].T_world_body * vis_first.T_world_body.inverse();
+  for (std::size_t i = a.second.front() + 1; i <= a.second.back(); ++i)
+    d.path += (truth[i].T_world_body.translation() - truth[i - 1].T_world_body.translation()).norm();
+  d.end_error = ((T_truth_est * vis_last.T_world_body).translation() -
+                 truth[a.second.back()].T_world_body.translation()).norm();
   return d;
 }
 
