@@ -104,6 +104,15 @@ void FixedLagSmoother::initialize(const imu::NavState& state, const imu::ImuBias
   impl_->initialized = true;
 }
 
+void FixedLagSmoother::setFirstVelocitySigma(double sigma) {
+  if (!std::isfinite(sigma) || sigma <= 0)
+    throw std::invalid_argument("FixedLagSmoother::setFirstVelocitySigma: sigma must be finite and > 0");
+  if (!impl_->initialized || impl_->window.nodes.size() != 1)
+    throw std::logic_error("FixedLagSmoother::setFirstVelocitySigma: only on a freshly initialized window");
+  // r = L dx with dx = [dp, dtheta, dv, dbg, dba]: the velocity rows are 6..8, and the prior is diagonal there.
+  impl_->window.prior.sqrt_information.block<3, 3>(6, 6) = Eigen::Matrix3d::Identity() / sigma;
+}
+
 namespace {
 
 // U with U^T U = C^-1 for a finite, symmetric, positive definite C; nothing otherwise.

@@ -77,6 +77,10 @@ class FixedLagSmoother {
   // also when the covariance is not finite, symmetric and positive definite.
   void initialize(const imu::NavState& state, const imu::ImuBias& bias, const imu::PreintegrationConfig& imu,
                   const Eigen::Matrix3d& gyro_bias_covariance);
+  // A start known to be at rest: the first state's velocity prior becomes N(state.v_world, sigma^2 I) [m/s] instead of
+  // the config's prior_sigma_velocity (a start whose velocity is unknown). Only on a fresh window (one state, no
+  // update yet): throws std::logic_error otherwise, std::invalid_argument for a sigma that is not finite and > 0.
+  void setFirstVelocitySigma(double sigma);
   // The newest state's gyro bias marginal covariance [(rad/s)^2] given everything in the window (the inverse of
   // the window's Gauss-Newton information at the current estimate; bit-identical for equal windows wherever their
   // states lie in memory). Nothing when not initialized or when the covariance cannot be computed.

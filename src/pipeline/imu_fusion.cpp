@@ -73,6 +73,9 @@ void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
   state.t = t0;
   state.T_world_imu = T_world_imu0_;
   restart(state, r.bias);
+  // At rest by the IMU window: the velocity is known (zero), not merely unknown around zero.
+  if (r.is_static && config_.static_start_sigma_velocity > 0)
+    smoother_.setFirstVelocitySigma(config_.static_start_sigma_velocity);
   initialized_ = true;
   sweeps_to_moving_restart_ = config_.moving_start_restart > 0 ? config_.moving_start_restart : kDone;
   static_start_ = r.is_static;

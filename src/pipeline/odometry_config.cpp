@@ -29,6 +29,8 @@ LoopClosureConfig OdometryConfig::loopClosure() const {
 std::string OdometryConfig::validate() const {
   if (deskew_refinements < 0 || deskew_refinements > 10)
     return "deskew_refinements must be in [0, 10], got " + std::to_string(deskew_refinements);
+  if (!std::isfinite(static_start_sigma_velocity) || static_start_sigma_velocity < 0)
+    return "static_start_sigma_velocity must be finite and >= 0, got " + std::to_string(static_start_sigma_velocity);
   if (!(moving_start_speed >= 0))
     return "moving_start_speed must be finite and >= 0, got " + std::to_string(moving_start_speed);
   if (moving_start_restart < 0)

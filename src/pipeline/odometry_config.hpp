@@ -58,6 +58,16 @@ struct OdometryConfig {
   // height through gravity_roll_pitch). 0 disables (the smoother keeps the start at rest).
   int moving_start_restart = 3;
   double moving_start_speed = 0.2;
+  // [m/s] sigma of the smoother's first velocity after a static start (the IMU window said the platform was at rest)
+  // instead of smoother.prior_sigma_velocity (1 m/s, for a start whose velocity is unknown); 0: off, the default.
+  // Where the lidar leaves a direction to the IMU from the first sweep on (a start in the corridor), nothing else
+  // says the start was at rest: there the accelerometer bias along the axis (0.02 m/s^2, unobservable standing still
+  // with the 9-axis attitude) made the LIS creep at 4 cm/s, and when the VIS's motion arrived the loose prior let the
+  // smoother explain the creep as a velocity error since the start and move the pose back 7 cm in one sweep. With
+  // 0.01 the corridor course (drover preset, Shi-Tomasi) went 0.116 -> 0.070 m; but the farm's LIS alone, seed 1,
+  // 3.58 -> 8.79 m (its height on the ramps at 30-60 s, where the first prior is long marginalised: a perturbation
+  // the course amplifies, not yet understood), so it is not on by default (bench/RESULTS.md).
+  double static_start_sigma_velocity = 0.0;
   lidar::ScanLayoutConfig layout = lidar::ScanLayoutConfig::vlp16();
   lidar::FeatureExtractorConfig features;
   lidar::LocalMapConfig local_map;

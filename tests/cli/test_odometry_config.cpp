@@ -105,7 +105,8 @@ TEST(OdometryConfigReader, EveryTopLevelKeyReachesItsOwnField) {
                                 "  lidar_sigma_position: 0.04\n  lidar_sigma_rotation: 0.03\n  degenerate_sigma: 5\n"
                                 "  gravity_roll_pitch: false\n  deskew_refinements: 2\n"
                                 "  degenerate_restart_sweeps: 11\n  use_imu_orientation: false\n"
-                                "  moving_start_restart: 5\n  moving_start_speed: 0.4\n");
+                                "  moving_start_restart: 5\n  moving_start_speed: 0.4\n"
+                                "  static_start_sigma_velocity: 0.02\n");
   EXPECT_FALSE(c.use_imu);
   EXPECT_FALSE(c.deskew);
   EXPECT_EQ(c.min_points, 50);
@@ -118,6 +119,8 @@ TEST(OdometryConfigReader, EveryTopLevelKeyReachesItsOwnField) {
   EXPECT_EQ(c.degenerate_restart_sweeps, 11);
   EXPECT_EQ(c.moving_start_restart, 5);
   EXPECT_DOUBLE_EQ(c.moving_start_speed, 0.4);
+  EXPECT_DOUBLE_EQ(c.static_start_sigma_velocity, 0.02);
+  EXPECT_EQ(OdometryConfig{}.static_start_sigma_velocity, 0.0) << "off by default";
   EXPECT_FALSE(c.initializer.use_orientation);
   EXPECT_TRUE(OdometryConfig{}.initializer.use_orientation) << "a 9-axis unit's orientation is used by default";
 }
@@ -358,12 +361,14 @@ TEST(OdometryConfigReader, AValueThatFailsValidationIsAnErrorNamingFileAndTheOdo
   EXPECT_TRUE(has(w, file) && has(w, "section 'odometry'") && has(w, "window")) << w;
 }
 
-TEST(OdometryConfigReader, ANegativeMovingStartSettingIsAnErrorNamingTheKey) {
+TEST(OdometryConfigReader, ANegativeMovingOrStaticStartSettingIsAnErrorNamingTheKey) {
   test::TempDir dir;
   const std::string r = errorOf(dir, "odometry:\n  moving_start_restart: -1\n");
   EXPECT_TRUE(has(r, "section 'odometry'") && has(r, "moving_start_restart must be >= 0")) << r;
   const std::string v = errorOf(dir, "odometry:\n  moving_start_speed: -0.5\n");
   EXPECT_TRUE(has(v, "section 'odometry'") && has(v, "moving_start_speed must be finite and >= 0")) << v;
+  const std::string s = errorOf(dir, "odometry:\n  static_start_sigma_velocity: -0.01\n");
+  EXPECT_TRUE(has(s, "section 'odometry'") && has(s, "static_start_sigma_velocity must be finite and >= 0")) << s;
 }
 
 TEST(OdometryConfigReader, AMissingFileIsAnErrorNamingIt) {

@@ -162,6 +162,7 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .bind("degenerate_restart_sweeps", c.degenerate_restart_sweeps)
       .bind("moving_start_restart", c.moving_start_restart)
       .bind("moving_start_speed", c.moving_start_speed)
+      .bind("static_start_sigma_velocity", c.static_start_sigma_velocity)
       .bind("use_imu_orientation", c.initializer.use_orientation)
       .nested("layout", [&](YamlSection& s) { bindLayout(s, c.layout, e); })
       .nested("features", [&](YamlSection& s) { bindFeatures(s, c.features, f); })

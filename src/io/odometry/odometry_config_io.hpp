@@ -6,7 +6,8 @@
 //             degenerate_sigma, use_imu_orientation (take a 9-axis unit's orientation at initialisation; false
 //             when it is not of the IMU's acc/gyro frame, as LIO-SAM's extrinsicRPY != extrinsicRot says)
 //             degenerate_pose_from_match (a degenerate match keeps its own pose, as LIO-SAM; default: the smoother's)
-//             moving_start_restart [sweeps], moving_start_speed [m/s] (a start in motion: pipeline/odometry_config.hpp)
+//             moving_start_restart [sweeps], moving_start_speed [m/s] (a start in motion: pipeline/odometry_config.hpp),
+//             static_start_sigma_velocity [m/s] (the first velocity's sigma after a static start; 0 = off)
 //     layout:       n_rings, vertical_fov_min_deg, vertical_fov_max_deg, columns, scan_period [s],
 //                   spin (ccw | cw), ring_source (elevation | order), order_top_down, min_range, max_range [m]
 //     features:     edge_threshold, surf_threshold (LIO-SAM edgeThreshold/surfThreshold), surf_leaf, edge_leaf,
