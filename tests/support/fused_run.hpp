@@ -88,14 +88,11 @@ inline FusedRun runFused(const LiveCourse& course, Time until = 0, bool factor =
   r.degenerate_places = lis.loopClosure().stats().degenerate_places;
   const Trajectory& est = lis.trajectory();
   r.lis = est;
-  const Eigen::Isometry3d T_lidar_imu = course.calibration.T_imu_lidar.inverse();
-  const Eigen::Isometry3d* first = truthAt(course.truth, est.front().t);
-  const Eigen::Isometry3d* last = truthAt(course.truth, est.back().t);
-  if (first == nullptr || last == nullptr) return r;
+  const std::optional<Eigen::Isometry3d> T_truth_est = alignedByFirstSweep(est, course);
+  if (!T_truth_est || truthAt(course.truth, est.back().t) == nullptr) return r;
   for (std::size_t i = 1; i < course.truth.size(); ++i)
     r.path += (course.truth[i].T_world_body.translation() - course.truth[i - 1].T_world_body.translation()).norm();
-  const Eigen::Isometry3d T_truth_est = *first * (est.front().T_world_body * T_lidar_imu).inverse();
-  r.end_error = ((T_truth_est * est.back().T_world_body * T_lidar_imu).translation() - last->translation()).norm();
+  r.end_error = sweepError(est.back(), *T_truth_est, course);
   return r;
 }
 

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdlib>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -84,21 +86,43 @@ inline const Eigen::Isometry3d* truthAt(const Trajectory& truth, Time t) {
   return it != truth.end() && it->t == t ? &it->T_world_body : nullptr;
 }
 
-// The largest position error [m] of the LIS's per-sweep IMU poses from `first` on, with the estimate aligned to the
-// truth at its first sweep (the odometry's world is that sweep's gravity-aligned frame).
-inline double worstSweepError(const Trajectory& sweeps, const LiveCourse& course, Time first = 0) {
-  if (sweeps.empty()) return 1e9;
-  const Eigen::Isometry3d T_lidar_imu = course.calibration.T_imu_lidar.inverse();
+// The transform putting the LIS's per-sweep IMU poses into the truth's frame by their first sweep (the odometry's
+// world is that sweep's gravity-aligned frame), or nothing without a truth there.
+inline std::optional<Eigen::Isometry3d> alignedByFirstSweep(const Trajectory& sweeps, const LiveCourse& course) {
+  if (sweeps.empty()) return std::nullopt;
   const Eigen::Isometry3d* start = truthAt(course.truth, sweeps.front().t);
-  if (start == nullptr) return 1e9;
-  const Eigen::Isometry3d T_truth_est = *start * (sweeps.front().T_world_body * T_lidar_imu).inverse();
+  if (start == nullptr) return std::nullopt;
+  return *start * (sweeps.front().T_world_body * course.calibration.T_imu_lidar.inverse()).inverse();
+}
+
+// The position error [m] of one per-sweep pose under that alignment; 1e9 without a truth at its stamp.
+inline double sweepError(const StampedPose& p, const Eigen::Isometry3d& T_truth_est, const LiveCourse& course) {
+  const Eigen::Isometry3d* truth = truthAt(course.truth, p.t);
+  if (truth == nullptr) return 1e9;
+  return ((T_truth_est * p.T_world_body * course.calibration.T_imu_lidar.inverse()).translation() -
+          truth->translation()).norm();
+}
+
+// The largest position error [m] of the LIS's per-sweep IMU poses from `first` on, aligned by their first sweep.
+inline double worstSweepError(const Trajectory& sweeps, const LiveCourse& course, Time first = 0) {
+  const std::optional<Eigen::Isometry3d> T_truth_est = alignedByFirstSweep(sweeps, course);
+  if (!T_truth_est) return 1e9;
   double worst = 0;
   for (const StampedPose& p : sweeps) {
-    const Eigen::Isometry3d* truth = truthAt(course.truth, p.t);
-    if (p.t < first || truth == nullptr) continue;
-    worst = std::max(worst, ((T_truth_est * p.T_world_body * T_lidar_imu).translation() - truth->translation()).norm());
+    if (p.t < first || truthAt(course.truth, p.t) == nullptr) continue;
+    worst = std::max(worst, sweepError(p, *T_truth_est, course));
   }
   return worst;
+}
+
+// The same at the sweep nearest t [m].
+inline double sweepErrorAt(const Trajectory& sweeps, const LiveCourse& course, Time t) {
+  const std::optional<Eigen::Isometry3d> T_truth_est = alignedByFirstSweep(sweeps, course);
+  if (!T_truth_est) return 1e9;
+  const auto nearest = std::min_element(sweeps.begin(), sweeps.end(), [t](const StampedPose& a, const StampedPose& b) {
+    return std::abs(a.t - t) < std::abs(b.t - t);
+  });
+  return sweepError(*nearest, *T_truth_est, course);
 }
 
 }  // namespace drover::test
