@@ -131,4 +131,22 @@ bool BiasRandomWalkFactor::Evaluate(double const* const* parameters, double* res
   return true;
 }
 
+BiasPriorFactor::BiasPriorFactor(const Vector6d& measured, double gyro_sigma, double acc_sigma)
+    : measured_(measured) {
+  const auto positive = [](double x) { return std::isfinite(x) && x > 0; };
+  if (!positive(gyro_sigma) || !positive(acc_sigma) || !measured.allFinite()) {
+    throw std::invalid_argument("BiasPriorFactor: gyro_sigma = " + std::to_string(gyro_sigma) + ", acc_sigma = " +
+                                std::to_string(acc_sigma) + " must be finite and > 0, and the measured bias finite");
+  }
+  weights_ << Eigen::Vector3d::Constant(1.0 / gyro_sigma), Eigen::Vector3d::Constant(1.0 / acc_sigma);
+}
+
+bool BiasPriorFactor::Evaluate(double const* const* parameters, double* residuals, double** jacobians) const {
+  const Eigen::Map<const Vector6d> b(parameters[0]);
+  Eigen::Map<Vector6d>{residuals} = weights_.cwiseProduct(b - measured_);
+  if (jacobians == nullptr) return true;
+  setJacobian<6, 6>(jacobians[0], Matrix6d(weights_.asDiagonal()));
+  return true;
+}
+
 }  // namespace drover::backend

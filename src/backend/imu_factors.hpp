@@ -50,4 +50,17 @@ class BiasRandomWalkFactor final : public ceres::SizedCostFunction<6, 6, 6> {
   Vector6d weights_;
 };
 
+// A prior on one frame's biases [b_g; b_a] around a measured value (another estimator's biases: the LIS's, in the
+// VIS window): r = (b - b_measured) / sigma per axis. gyro_sigma [rad/s], acc_sigma [m/s^2]; both must be > 0 and
+// finite (std::invalid_argument otherwise).
+class BiasPriorFactor final : public ceres::SizedCostFunction<6, 6> {
+ public:
+  BiasPriorFactor(const Vector6d& measured, double gyro_sigma, double acc_sigma);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  Vector6d measured_;
+  Vector6d weights_;
+};
+
 }  // namespace drover::backend

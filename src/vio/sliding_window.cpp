@@ -108,6 +108,7 @@ std::vector<Eigen::Isometry3d> SlidingWindowEstimator::cameraPoses() const {
 
 void SlidingWindowEstimator::reset() {
   init_prior_.active = false;
+  lis_bias_.reset();
   coasting_since_.reset();
   aligned_visually_ = false;
   history_.clear();
@@ -160,6 +161,9 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
       return result;
     }
   }
+  lis_bias_.reset();
+  if (seed && config_.lis_bias_prior_sigma_acc > 0)
+    if (const std::optional<SeedState> s = seed(frames_.back()->t)) lis_bias_ = s->bias;
   optimize(result);
   removeOutliers(result);
   checkCoasting(result, static_cast<bool>(seed));

@@ -158,6 +158,8 @@ class SlidingWindowEstimator {
     double p[3], q[4], v[3], bias[6];  // the oldest frame's state at initialisation
   };
   InitPrior init_prior_;
+  // The LIS's biases at the newest frame (vio.lis_bias_prior_sigma_*): a prior in its solves only.
+  std::optional<imu::ImuBias> lis_bias_;
   // The scale check after a visual initialisation (window_scale_check.cpp): the keyframes that left the window,
   // each with the IMU from the one before, and the IMU from the newest of them to the window's oldest frame.
   std::deque<ScaleCheckFrame> history_;

@@ -54,6 +54,11 @@ struct VioConfig {
   double lis_sigma_velocity = 0.5;       // [m/s] (weak: the seed is a finite difference; a tight one fixes its error)
   double lis_sigma_gyro_bias = 0.005;    // [rad/s]
   double lis_sigma_acc_bias = 0.1;       // [m/s^2]
+  // While the LIS runs, its biases (fused over many lidar-matched sweeps) as a prior on the newest frame's biases
+  // at every solve, with these sigmas; never marginalised, so it does not pile up. It holds the tilt /
+  // accelerometer-bias pair that a straight drive leaves unobservable to the window. 0: off.
+  double lis_bias_prior_sigma_gyro = 0;  // [rad/s]
+  double lis_bias_prior_sigma_acc = 0;   // [m/s^2]
   // A seed is refused when the window's lidar-anchored tracks, moved by the LIS's poses, reproject to a median
   // error above seed_max_median_px [px at focal_px] over at least seed_min_observations observations (sliding
   // tracks on a textureless surface, or a LIS whose velocity drifted; vio/seed_agreement.hpp). 0 disables.

@@ -74,6 +74,13 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
                                                                        b.pre->deltaTime()),
                        nullptr, {a.bias, b.bias}});
   }
+  if (!oldest_only && lis_bias_) {  // the newest frame is never marginalised: the prior never enters the marginal
+    backend::Vector6d b;
+    b << lis_bias_->gyro, lis_bias_->acc;
+    r.items.push_back({std::make_unique<backend::BiasPriorFactor>(b, config_.lis_bias_prior_sigma_gyro,
+                                                                  config_.lis_bias_prior_sigma_acc),
+                       nullptr, {frames_.back()->bias}});
+  }
   // The longest tracks first (they constrain the window most), up to max_features.
   std::vector<Feature*> used;
   const int newest = static_cast<int>(n) - 1;

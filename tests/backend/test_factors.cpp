@@ -156,6 +156,24 @@ TEST(BiasRandomWalkFactor, WhitensTheBiasChangeBySigmaTimesSqrtDtWithExactJacobi
   EXPECT_THROW(BiasRandomWalkFactor(0.0, 3e-4, 0.1), std::invalid_argument);
 }
 
+TEST(BiasPriorFactor, WhitensTheBiasErrorPerAxisWithExactJacobians) {
+  Vector6d measured;
+  measured << 0.002, -0.001, 0.0015, 0.02, -0.03, 0.01;
+  const BiasPriorFactor factor(measured, 0.001, 0.02);
+  EXPECT_LT(evaluate(factor, {vectorParam(measured)}).norm(), 1e-15);
+  Vector6d b = measured;
+  b(1) += 0.002;  // two gyro sigmas
+  b(5) -= 0.01;   // half an accelerometer sigma
+  const Eigen::VectorXd r = evaluate(factor, {vectorParam(b)});
+  EXPECT_NEAR(r(1), 2.0, 1e-9);
+  EXPECT_NEAR(r(5), -0.5, 1e-9);
+  EXPECT_NEAR(r.norm(), std::sqrt(4.25), 1e-9);
+  EXPECT_LT(tangentJacobianError(factor, {vectorParam(b)}), kJacobianTolerance);
+  EXPECT_THROW(BiasPriorFactor(measured, 0.0, 0.02), std::invalid_argument);
+  measured(3) = std::nan("");
+  EXPECT_THROW(BiasPriorFactor(measured, 0.001, 0.02), std::invalid_argument);
+}
+
 TEST(PosePriorFactor, GivesTheWhitenedSe3ErrorAndExactJacobians) {
   std::mt19937 rng(4);
   const Eigen::Isometry3d T_m = randomState(rng).T_world_imu;

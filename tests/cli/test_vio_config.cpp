@@ -42,6 +42,8 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   seed_min_observations: 40
   max_imu_gap_s: 0.2
   imu_midpoint: false
+  lis_bias_prior_sigma_gyro: 0.001
+  lis_bias_prior_sigma_acc: 0.02
 )"));
   EXPECT_EQ(c.window, 7);
   EXPECT_DOUBLE_EQ(c.min_parallax_px, 12.5);
@@ -63,6 +65,8 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   EXPECT_EQ(c.seed_min_observations, 40);
   EXPECT_DOUBLE_EQ(c.max_imu_gap_s, 0.2);
   EXPECT_FALSE(c.imu_midpoint);
+  EXPECT_DOUBLE_EQ(c.lis_bias_prior_sigma_gyro, 0.001);
+  EXPECT_DOUBLE_EQ(c.lis_bias_prior_sigma_acc, 0.02);
 }
 
 TEST(VioConfigIo, AFileWithoutTheSectionGivesTheDefaults) {
@@ -76,7 +80,9 @@ TEST(VioConfigIo, ANegativeSeedThresholdOrNoObservationsIsAnErrorNamingTheValue)
   TempDir dir;
   for (const auto& [yaml, words] : std::vector<std::pair<std::string, std::string>>{
            {"vio:\n  seed_max_median_px: -1\n", "seed_max_median_px must be >= 0"},
-           {"vio:\n  seed_min_observations: 0\n", "seed_min_observations must be >= 1"}}) {
+           {"vio:\n  seed_min_observations: 0\n", "seed_min_observations must be >= 1"},
+           {"vio:\n  lis_bias_prior_sigma_acc: 0.02\n", "both 0 (off) or both > 0"},
+           {"vio:\n  lis_bias_prior_sigma_gyro: -1\n  lis_bias_prior_sigma_acc: 0.02\n", "must be >= 0"}}) {
     SCOPED_TRACE(yaml);
     const std::string path = write(dir, yaml);
     test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", words});
