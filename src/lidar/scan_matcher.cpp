@@ -52,7 +52,7 @@ Match matchPoint(const Eigen::Vector3f& p_lidar, bool is_edge, const Eigen::Isom
   for (std::size_t i = 0; i < k; ++i) neighbours[i] = cloud[idx[i]].cast<double>();
   const int n = static_cast<int>(k);
   match.fit = is_edge ? detail::fitLine(neighbours.data(), n, c.edge_eigen_ratio)
-                      : detail::fitPlane(neighbours.data(), n, c.plane_tolerance);
+                      : detail::fitPlane(neighbours.data(), n, c.plane_tolerance, c.plane_min_aspect);
   if (!match.fit.valid) return match;
   Eigen::Vector2d r;
   Eigen::Matrix<double, 2, 6> J;
@@ -199,6 +199,9 @@ std::string ScanMatcherConfig::validate() const {
     if (!std::isfinite(value) || value <= 0.0) {
       return std::string("scan matcher ") + name + " must be finite and > 0, got " + std::to_string(value);
     }
+  }
+  if (!(plane_min_aspect >= 0.0 && plane_min_aspect < 1.0)) {
+    return "scan matcher plane_min_aspect must be in [0, 1), got " + std::to_string(plane_min_aspect);
   }
   if (!(min_weight >= 0.0 && min_weight < 1.0)) {
     return "scan matcher min_weight must be in [0, 1), got " + std::to_string(min_weight);

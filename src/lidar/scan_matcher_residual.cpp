@@ -39,13 +39,15 @@ FeatureFit fitLine(const Eigen::Vector3d* points, int count, double eigen_ratio)
   return fit;
 }
 
-FeatureFit fitPlane(const Eigen::Vector3d* points, int count, double tolerance) {
+FeatureFit fitPlane(const Eigen::Vector3d* points, int count, double tolerance, double min_aspect) {
   FeatureFit fit;
   if (count < 3) return fit;
   const auto eig = neighbourEigen(points, count, fit.anchor);
   const Eigen::Vector3d values = eig.eigenvalues();
   // Collinear neighbours span no plane: the middle eigenvalue would be ~0.
   if (!(values(1) > 1e-6 * values(2)) || values(2) <= 0.0) return fit;
+  // A thin strip (one scan ring's arc) fixes its normal only through its curvature: the normal may turn about it.
+  if (values(1) < min_aspect * min_aspect * values(2)) return fit;
   fit.direction = eig.eigenvectors().col(0).normalized();
   for (int i = 0; i < count; ++i) {
     if (std::abs(fit.direction.dot(points[i] - fit.anchor)) > tolerance) return fit;

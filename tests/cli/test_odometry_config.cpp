@@ -175,6 +175,7 @@ TEST(OdometryConfigReader, EveryLocalMapMatcherAndKeyframeKeyReachesItsOwnField)
       "    retire_radius: 0.7\n    retire_age: 45\n"
       "  matcher:\n    max_iterations: 12\n    convergence_translation: 0.001\n    convergence_rotation: 0.002\n"
       "    neighbors: 6\n    max_neighbor_distance: 1.5\n    edge_eigen_ratio: 4\n    plane_tolerance: 0.15\n"
+      "    plane_min_aspect: 0.05\n"
       "    kernel: huber\n    min_weight: 0.2\n    huber_delta: 0.05\n    degeneracy_threshold: 50\n"
       "    min_edge_features: 5\n    min_plane_features: 60\n    min_correspondences: 40\n"
       "  keyframes:\n    distance: 0.5\n    angle: 0.1\n");
@@ -197,6 +198,7 @@ TEST(OdometryConfigReader, EveryLocalMapMatcherAndKeyframeKeyReachesItsOwnField)
   EXPECT_DOUBLE_EQ(s.max_neighbor_distance, 1.5);
   EXPECT_DOUBLE_EQ(s.edge_eigen_ratio, 4.0);
   EXPECT_DOUBLE_EQ(s.plane_tolerance, 0.15);
+  EXPECT_DOUBLE_EQ(s.plane_min_aspect, 0.05);
   EXPECT_EQ(s.kernel, lidar::RobustKernel::kHuber);
   EXPECT_DOUBLE_EQ(s.min_weight, 0.2);
   EXPECT_DOUBLE_EQ(s.huber_delta, 0.05);

@@ -77,6 +77,7 @@ void bindMatcher(YamlSection& s, lidar::ScanMatcherConfig& c, EnumStrings& e) {
       .bind("max_neighbor_distance", c.max_neighbor_distance)
       .bind("edge_eigen_ratio", c.edge_eigen_ratio)
       .bind("plane_tolerance", c.plane_tolerance)
+      .bind("plane_min_aspect", c.plane_min_aspect)
       .bindChoice("kernel", e.kernel, {"lio-sam", "huber"})
       .bind("min_weight", c.min_weight)
       .bind("huber_delta", c.huber_delta)
