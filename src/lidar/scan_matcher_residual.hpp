@@ -27,7 +27,8 @@ struct FeatureFit {
 FeatureFit fitLine(const Eigen::Vector3d* points, int count, double eigen_ratio);
 // Plane through the neighbours' mean with the smallest-eigenvalue eigenvector as normal (PCA; LIO-SAM solves
 // A n = -1, which fails for planes through the origin). Valid when every neighbour lies within `tolerance` [m]
-// of the plane and the neighbours are not collinear.
+// of the plane, the neighbours are not collinear, and their spread across their longest direction is at least
+// `min_aspect` of their spread along it (ScanMatcherConfig::plane_min_aspect).
 FeatureFit fitPlane(const Eigen::Vector3d* points, int count, double tolerance, double min_aspect = 0.0);
 
 // r (first fit.rows entries) at T_world_lidar for the lidar point p_lidar; J the matching rows of dr/ddxi.

@@ -328,10 +328,10 @@ TEST(ScanMatcherResidual, RejectsScatteredLinesAndBentPlanes) {
   EXPECT_TRUE(detail::fitLine(collinear.data(), 5, 3.0).valid);
 }
 
-// Five map points along one ring of a spinning lidar on flat ground (radius 8 m, 0.2 m apart, +-1 cm range noise along a
-// beam 15 deg down)
-// span a strip whose width is the ring's curvature and the noise: a plane through them may turn about the ring, and
-// it does (the fitted normal leans far from the vertical). Two rings 0.5 m apart fix the ground's normal.
+// Five map points along one ring of a spinning lidar on flat ground (radius 8 m, 0.2 m apart, +-1 cm of range noise
+// along a beam 15 deg down) span a strip whose width is the ring's curvature and the noise: a plane through them may
+// turn about the ring, and it does (the fitted normal leans far from the vertical). Two rings 0.5 m apart fix the
+// ground's normal.
 TEST(ScanMatcherResidual, RefusesAPlaneAlongOneScanRingUnlessTheNeighboursSpanIt) {
   std::vector<Eigen::Vector3d> ring;
   const double noise[] = {0.01, -0.01, 0.0, 0.01, -0.01};
@@ -351,7 +351,8 @@ TEST(ScanMatcherResidual, RefusesAPlaneAlongOneScanRingUnlessTheNeighboursSpanIt
   std::vector<Eigen::Vector3d> two_rings;
   for (const double r : {8.0, 8.5})
     for (int i = -1; i <= 1; ++i)
-      if (two_rings.size() < 5) two_rings.push_back(Eigen::Vector3d(r * std::cos(i * 0.025), r * std::sin(i * 0.025), 0.0));
+      if (two_rings.size() < 5)
+        two_rings.push_back(Eigen::Vector3d(r * std::cos(i * 0.025), r * std::sin(i * 0.025), 0.0));
   const detail::FeatureFit ground = detail::fitPlane(two_rings.data(), 5, 0.2, kAspect);
   ASSERT_TRUE(ground.valid);
   EXPECT_GT(std::abs(ground.direction.z()), std::cos(1.0 * M_PI / 180.0));

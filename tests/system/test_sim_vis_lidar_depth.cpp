@@ -79,8 +79,8 @@ TEST(SimVisLidarDepth, TheLisBiasesAsAPriorHoldTheVisTiltOnAStraightDescent) {
   std::printf("downhill, the VIS with the LIS's biases as a prior: largest tilt error %.2f deg, end error %.2f %%\n",
               tilt, 100 * d.end_error / d.path);
   ASSERT_GT(d.path, 25.0);
-  EXPECT_LT(tilt, 0.5);                       // measured 0.15 deg (without the prior 1.93 deg)
-  EXPECT_LT(d.end_error / d.path, 0.02);      // measured 1.11 % (without 1.09 %): the scale is not the tilt's
+  EXPECT_LT(tilt, 0.5);                   // measured 0.15 deg (without the prior 1.93 deg)
+  EXPECT_LT(d.end_error / d.path, 0.02);  // measured 1.11 % (without 1.09 %): the scale is not the tilt's
 }
 
 }  // namespace
