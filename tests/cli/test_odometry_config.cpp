@@ -373,6 +373,15 @@ TEST(OdometryConfigReader, ANegativeMovingOrStaticStartSettingIsAnErrorNamingThe
   EXPECT_TRUE(has(s, "section 'odometry'") && has(s, "static_start_sigma_velocity must be finite and >= 0")) << s;
 }
 
+TEST(OdometryConfigReader, APlaneAspectOutsideZeroToOneIsAnErrorNamingFileAndKey) {
+  test::TempDir dir;
+  const std::string file = (dir / "odometry.yaml").string();
+  for (const char* value : {"1.0", "-0.1"}) {
+    const std::string e = errorOf(dir, std::string("odometry:\n  matcher:\n    plane_min_aspect: ") + value + "\n");
+    EXPECT_TRUE(has(e, file) && has(e, "section 'odometry'") && has(e, "plane_min_aspect must be in [0, 1)")) << e;
+  }
+}
+
 TEST(OdometryConfigReader, AMissingFileIsAnErrorNamingIt) {
   test::TempDir dir;
   const std::string path = (dir / "absent.yaml").string();
