@@ -18,6 +18,20 @@ namespace {
 
 void appendWarning(ScanOutcome& out, const std::string& w) { out.warning += (out.warning.empty() ? "" : "; ") + w; }
 
+// How far the LIS moved over the VIS's keyframe gaps: the fused path up to the newest fused state (xa), then the
+// prediction's straight line to the sweep (xb), the share of it after the keyframe.
+KeyframeTravel travelOf(const PathOdometer& odometer, const VisualIncrement& inc, const imu::NavState& xa,
+                        const imu::NavState& xb) {
+  const double ahead = (xb.T_world_imu.translation() - xa.T_world_imu.translation()).norm();
+  const Time kf = inc.last_keyframe_at;
+  const double share = kf <= xa.t || xb.t <= xa.t ? 1.0
+                                                  : std::max(0.0, toSeconds(xb.t - kf) / toSeconds(xb.t - xa.t));
+  KeyframeTravel travel;
+  travel.since_keyframe = odometer.between(kf, xa.t) + share * ahead;
+  travel.keyframe_interval = odometer.between(kf - inc.keyframe_interval, kf);
+  return travel;
+}
+
 // Velocity of the IMU from the last two lidar poses [m/s] (for a restart), zero with fewer.
 Eigen::Vector3d velocityFrom(const Trajectory& trajectory, const Eigen::Isometry3d& T_lidar_imu) {
   if (trajectory.size() < 2) return Eigen::Vector3d::Zero();
@@ -101,6 +115,7 @@ void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias,
     smoother_.initialize(state, bias, config_.preintegration);
   }
   propagator_.reset(state, bias);
+  odometer_.add(state.t, state.T_world_imu.translation());
 }
 
 // The smoother restarts in the corrected world (LIO-SAM resets its IMU graph on the corrected odometry), but the
@@ -118,6 +133,7 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
   imu::NavState state = smoother_.state();
   state.T_world_imu = T_new_old * state.T_world_imu;
   state.v_world = T_new_old.linear() * state.v_world;
+  odometer_.moveWorld(T_new_old);  // a correction is no motion
   const double tilt = (T_new_old.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitZ()).norm();  // [rad]
   if (tilt < 1e-9) {
     restart(state, smoother_.bias(), std::nullopt, smoother_.biasCovariance());
@@ -220,6 +236,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     return;
   }
   propagator_.reset(r.state, r.bias);
+  odometer_.add(r.state.t, r.state.T_world_imu.translation());
   out.has_imu_state = true;
   out.v_world = r.state.v_world;
   out.gyro_bias = r.bias.gyro;
@@ -255,7 +272,8 @@ std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b,
   if (!inc) return std::nullopt;
   const std::optional<imu::NavState> xa = propagator_.stateAt(a), xb = propagator_.stateAt(b);
   if (!xa || !xb) return inc;  // no prediction to hold it against (the smoother restarts)
-  if (std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion); !d.empty()) {
+  if (std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion, travelOf(odometer_, *inc, *xa, *xb));
+      !d.empty()) {
     if (why != nullptr) *why = std::move(d);
     if (disagreed != nullptr) *disagreed = true;
     return std::nullopt;

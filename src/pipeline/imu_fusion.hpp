@@ -13,6 +13,7 @@
 #include "imu/propagator.hpp"
 #include "lidar/deskew.hpp"
 #include "pipeline/odometry_config.hpp"
+#include "pipeline/path_odometer.hpp"
 #include "pipeline/visual_motion.hpp"
 #include "types/imu.hpp"
 #include "types/trajectory.hpp"
@@ -96,6 +97,7 @@ class ImuFusion {
   backend::FixedLagSmoother smoother_;
   VisualMotion visual_;
   VisualWatch visual_watch_;
+  PathOdometer odometer_;  // the fused states' path, for the VIS's keyframe gate
   bool initialized_ = false, given_up_ = false;
   Time t_start_ = 0;                  // [ns] the first sweep's stamp
   // Sweeps left until the moving-start check (> 0), then its retries (<= 0); kDone when judged or disabled.

@@ -24,7 +24,8 @@ std::string VisualMotionConfig::validate() const {
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
                                 {"warmup", warmup},
                                 {"reset_after", reset_after},
-                                {"standing_speed", standing_speed}})
+                                {"standing_speed", standing_speed},
+                                {"keyframe_gap_min_distance", keyframe_gap_min_distance}})
     if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
   if (min_features < 1 || full_features < min_features)
     return fmt::format("need 0 < min_features <= full_features, got {} and {}", min_features, full_features);
@@ -163,10 +164,16 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
 namespace drover::pipeline {
 
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
-                                const VisualMotionConfig& config) {
+                                const VisualMotionConfig& config, const KeyframeTravel& travel) {
   const Eigen::Vector3d v_b_imu = b.T_world_imu.linear().transpose() * b.v_world;
-  const double gap = std::max(toSeconds(b.t - inc.last_keyframe_at), toSeconds(inc.keyframe_interval));
-  if (gap > config.max_keyframe_gap && v_b_imu.norm() > config.standing_speed)
+  // A gap is a stall only when the robot moved over it: since the newest keyframe, or between it and the one before
+  // (a lone keyframe after a stall).
+  const double min_travel = config.keyframe_gap_min_distance;
+  const double since = toSeconds(b.t - inc.last_keyframe_at), interval = toSeconds(inc.keyframe_interval);
+  const double gap = std::max(since > config.max_keyframe_gap && travel.since_keyframe >= min_travel ? since : 0.0,
+                              interval > config.max_keyframe_gap && travel.keyframe_interval >= min_travel ? interval
+                                                                                                        : 0.0);
+  if (gap > 0 && v_b_imu.norm() > config.standing_speed)
     return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s", gap, v_b_imu.norm());
   const double dv = (inc.v_b - v_b_imu).norm();
   if (dv > config.max_velocity_difference)

@@ -11,6 +11,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -64,6 +65,11 @@ struct VisualMotionConfig {
   // out. Gross disagreement with the IMU prediction of the sweep interval (the catch-up jump) is refused too.
   double max_keyframe_gap = 0.5;          // [s] (a moving VIS makes 7-10 keyframes a second)
   double standing_speed = 0.2;            // [m/s]
+  // ... and the LIS moved at least this far since that keyframe (or between it and the one before): a VIS whose last
+  // keyframe was taken standing has none due until it has moved. Pulling away at 0.4 m/s^2 after a stand, the time
+  // gap alone refused the VIS for 0.3-0.5 s (its first moving keyframe, 0.16 m on, came 1.3 s after the standing
+  // one); a moving VIS keyframes every 8-11 cm at 0.8 m/s, and the white walls' stall drove 2.7 m. 0: time alone.
+  double keyframe_gap_min_distance = 0.25;  // [m]
   double max_velocity_difference = 1.0;   // [m/s] body-frame velocity at the later stamp
   double max_position_difference = 0.5;   // [m] translation between the stamps
   // A VIS the gates above refused for this long in a row is asked to reset (it then re-initialises from the LIS):
@@ -111,11 +117,19 @@ struct VisualIncrement {
   Time keyframe_interval = 0;                     // [ns] of the VIS state used at b
 };
 
+// How far the LIS moved [m] since the VIS's last keyframe (to b) and between that keyframe and the one before it;
+// unknown (infinite) leaves the keyframe gate to time alone.
+struct KeyframeTravel {
+  double since_keyframe = std::numeric_limits<double>::infinity();
+  double keyframe_interval = std::numeric_limits<double>::infinity();
+};
+
 // Empty when the increment agrees with the IMU's prediction of the same interval (states at a and b, world frame
 // of their own) within config.max_velocity_difference and max_position_difference, and the VIS made a keyframe
-// within max_keyframe_gap of b unless the prediction stands still; else why not.
+// within max_keyframe_gap of b (and the one before within that of it) unless the prediction stands still or the
+// LIS moved less than keyframe_gap_min_distance over the gap; else why not.
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
-                                const VisualMotionConfig& config);
+                                const VisualMotionConfig& config, const KeyframeTravel& travel = {});
 
 class VisualMotion {
  public:

@@ -298,4 +298,46 @@ TEST(VisualMotion, AStalledOrJumpingVisIsRefusedAHealthyOrStandingOneIsKept) {
   EXPECT_NE(disagreementWithImu(fast, a, b, c).find("velocity"), std::string::npos);
 }
 
+// A keyframe gap is a stall only when the robot moved over it. The corridor's VIS initialised standing (1.74 s),
+// the robot pulled away at 2 s at 0.4 m/s^2, and the first moving keyframe came 0.16 m on: by time alone the VIS
+// was refused until the keyframe after that (3.2 s), both for the standing keyframe's age and for the lone
+// keyframe's 1.3 s interval.
+TEST(VisualMotion, AKeyframeGapIsAStallOnlyWhenTheLisMovedOverIt) {
+  const Eigen::Isometry3d T_a = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d T_b = T_a;
+  T_b.translation() = Eigen::Vector3d(0.05, 0, 0);
+  const Time t_b = 3 * kSec;
+  const imu::NavState a{t_b - kSec / 10, T_a, Eigen::Vector3d(0.45, 0, 0)};
+  const imu::NavState b{t_b, T_b, Eigen::Vector3d(0.5, 0, 0)};
+  VisualMotionConfig c;  // keyframe gap 0.5 s, at least 0.25 m moved over it
+  VisualIncrement inc;
+  inc.T_a_b = T_a.inverse() * T_b;
+  inc.v_b = {0.5, 0, 0};
+  inc.last_keyframe_at = t_b - 1'260'000'000;  // taken standing
+  KeyframeTravel pulling_away;
+  pulling_away.since_keyframe = 0.16;
+  EXPECT_EQ(disagreementWithImu(inc, a, b, c, pulling_away), "");
+  KeyframeTravel stalled;  // the white walls: 2.7 m driven without a keyframe
+  stalled.since_keyframe = 2.7;
+  EXPECT_NE(disagreementWithImu(inc, a, b, c, stalled).find("no keyframe for 1.3 s"), std::string::npos);
+  EXPECT_NE(disagreementWithImu(inc, a, b, c).find("no keyframe"), std::string::npos) << "unknown travel: time alone";
+
+  VisualIncrement first_moving = inc;  // the first keyframe after the stand, 1.3 s after the standing one
+  first_moving.last_keyframe_at = t_b - kSec / 20;
+  first_moving.keyframe_interval = 1'300'000'000;
+  KeyframeTravel after_stand;
+  after_stand.since_keyframe = 0.02;
+  after_stand.keyframe_interval = 0.14;
+  EXPECT_EQ(disagreementWithImu(first_moving, a, b, c, after_stand), "");
+  KeyframeTravel after_stall = after_stand;  // a lone keyframe after a stall is not yet a healthy VIS
+  after_stall.keyframe_interval = 1.1;
+  EXPECT_NE(disagreementWithImu(first_moving, a, b, c, after_stall).find("no keyframe for 1.3 s"), std::string::npos);
+
+  c.keyframe_gap_min_distance = 0;  // time alone, as before the key
+  EXPECT_NE(disagreementWithImu(inc, a, b, c, pulling_away).find("no keyframe"), std::string::npos);
+  EXPECT_NE(disagreementWithImu(first_moving, a, b, c, after_stand).find("no keyframe"), std::string::npos);
+  c.keyframe_gap_min_distance = -0.1;
+  EXPECT_FALSE(c.validate().empty());
+}
+
 }  // namespace drover::pipeline

@@ -29,6 +29,8 @@ struct FusedRun {
   Trajectory lis;                  // the LIS's sweep-rate poses
   std::size_t degenerate_places = 0;  // keyframes the loop search skipped as degenerate (skip_degenerate_places)
   Trajectory vis;                  // the VIS's own T_world_imu at every frame it estimated
+  Time first_vis_factor = 0;        // [ns] the first sweep with the VIS's motion as a factor (0: none)
+  std::size_t keyframe_gap_refusals = 0;  // sweeps the keyframe gate refused the VIS ("no keyframe for ...")
 };
 
 // The replay of `course` up to `until` (0: all of it); with `factor` false the VIS's motion is only the matcher's
@@ -77,6 +79,8 @@ inline FusedRun runFused(const LiveCourse& course, Time until = 0, bool factor =
     if (const auto* imu = std::get_if<ImuSample>(&m)) vo.addImu(*imu);
     for (const pipeline::ScanOutcome& o : lis.process(m)) {
       if (o.has_imu_state) lis_bias = imu::ImuBias{o.gyro_bias, o.acc_bias};
+      if (o.vis_factor && r.first_vis_factor == 0) r.first_vis_factor = o.t;
+      if (o.vis_unused.find("no keyframe for") != std::string::npos) ++r.keyframe_gap_refusals;
       if (!o.vis_reset.empty() && vo.estimator().initialized()) {
         vo.reset();
         ++r.resets_by_the_lis;

@@ -126,6 +126,7 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bindSeconds("max_age", c.max_age, atLeast(0, "s"))
       .bindSeconds("max_keyframe_gap", c.max_keyframe_gap, atLeast(0, "s"))
       .bind("standing_speed", c.standing_speed)
+      .bind("keyframe_gap_min_distance", c.keyframe_gap_min_distance)
       .bind("max_velocity_difference", c.max_velocity_difference)
       .bind("max_position_difference", c.max_position_difference)
       .bindSeconds("reset_after", c.reset_after, atLeast(0, "s"));
