@@ -17,9 +17,12 @@ namespace {
 
 std::string lineOf(const YAML::Node& n) { return lineRecord(static_cast<std::size_t>(n.Mark().line + 1)); }
 
-std::string record(const YAML::Node& n, const std::string& dotted) {
+// `dotted` is the section's own path and a bound key's name: Drover's text, printed whole (echo() would cut the longer
+// ones, such as odometry.vis_fusion.keyframe_gap_min_distance, at 40 characters). A key the file made up is echoed.
+std::string record(const YAML::Node& n, const std::string& dotted, bool known = true) {
   const int line = n.Mark().line;
-  return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key " + echo(dotted);
+  return (line >= 0 ? lineRecord(static_cast<std::size_t>(line + 1)) + ", " : std::string()) + "key " +
+         (known ? "'" + dotted + "'" : echo(dotted));
 }
 
 // A key written twice in one map: yaml-cpp keeps both pairs, lookups find the first and readers that iterate take
@@ -131,7 +134,7 @@ void YamlSection::apply(const YAML::Node& node) const {
       std::string known;
       for (const auto& [k, _] : setters_) known += (known.empty() ? "" : ", ") + k;
       for (const auto& [k, _] : nested_) known += (known.empty() ? "" : ", ") + k;
-      fail(file_, record(kv.first, dotted), "unknown key (expected one of: " + known + ")");
+      fail(file_, record(kv.first, dotted, false), "unknown key (expected one of: " + known + ")");
     }
   }
 }

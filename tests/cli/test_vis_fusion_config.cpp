@@ -80,6 +80,10 @@ TEST(VisFusionConfigReader, BadValuesAndUnknownKeysAreErrorsNamingFileAndKey) {
   EXPECT_TRUE(has(zero, file) && has(zero, "max_position_difference")) << zero;
   const std::string floor = errorOf(dir, "odometry:\n  vis_fusion:\n    window_floor_rotation: 0\n");
   EXPECT_TRUE(has(floor, file) && has(floor, "window_floor_rotation")) << floor;
+  const std::string travel = errorOf(dir, "odometry:\n  vis_fusion:\n    keyframe_gap_min_distance: -0.1\n");
+  EXPECT_TRUE(has(travel, file) && has(travel, "keyframe_gap_min_distance")) << travel;
+  const std::string travel_text = errorOf(dir, "odometry:\n  vis_fusion:\n    keyframe_gap_min_distance: far\n");
+  EXPECT_TRUE(has(travel_text, file) && has(travel_text, "keyframe_gap_min_distance")) << travel_text;
   const std::string flag = errorOf(dir, "odometry:\n  vis_fusion:\n    window_covariance: maybe\n");
   EXPECT_TRUE(has(flag, file) && has(flag, "window_covariance")) << flag;
   const std::string unknown = errorOf(dir, "odometry:\n  vis_fusion:\n    facter: true\n");
