@@ -29,7 +29,7 @@ namespace {
 // LVI-SAM's updateInitialGuess takes the VINS odometry whenever its reset ID matches: no gates, no reset.
 void withoutGates(pipeline::VisualMotionConfig& f) {
   constexpr double kNever = std::numeric_limits<double>::max();
-  f.max_keyframe_gap = f.max_velocity_difference = f.max_position_difference = kNever;
+  f.max_keyframe_gap = f.max_velocity_difference = f.max_position_difference = f.max_acceleration_difference = kNever;
   f.reset_after = 0;
   f.min_features = 1;
 }

@@ -272,8 +272,10 @@ std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b,
   if (!inc) return std::nullopt;
   const std::optional<imu::NavState> xa = propagator_.stateAt(a), xb = propagator_.stateAt(b);
   if (!xa || !xb) return inc;  // no prediction to hold it against (the smoother restarts)
-  if (std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion, travelOf(odometer_, *inc, *xa, *xb));
-      !d.empty()) {
+  std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion, travelOf(odometer_, *inc, *xa, *xb));
+  if (d.empty())
+    d = accelerationDisagreement(*inc, *xb, config_.preintegration.gravity, propagator_.bias().acc, config_.vis_fusion);
+  if (!d.empty()) {
     if (why != nullptr) *why = std::move(d);
     if (disagreed != nullptr) *disagreed = true;
     return std::nullopt;

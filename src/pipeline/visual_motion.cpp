@@ -17,6 +17,7 @@ std::string VisualMotionConfig::validate() const {
                                 {"max_keyframe_gap", max_keyframe_gap},
                                 {"max_velocity_difference", max_velocity_difference},
                                 {"max_position_difference", max_position_difference},
+                                {"max_acceleration_difference", max_acceleration_difference},
                                 {"window_floor_position", window_floor_position},
                                 {"window_floor_rotation", window_floor_rotation}})
     if (!std::isfinite(v) || v <= 0) return fmt::format("{} must be finite and > 0, got {}", name, v);
@@ -139,6 +140,8 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
   inc.v_b = xb->T_world_imu.linear().transpose() * xb->v_world;
   inc.last_keyframe_at = sb->last_keyframe_at;
   inc.keyframe_interval = sb->keyframe_interval;
+  inc.gravity_b = xb->T_world_imu.linear().transpose() * Eigen::Vector3d(0, 0, -imu_.gravity);
+  inc.acc_bias_b = sb->bias.acc;
   inc.sqrt_information.setZero();
   if (config_.window_covariance) {
     if (const std::optional<Eigen::Matrix<double, 6, 6>> cov = windowCovariance(sa, sb)) {
@@ -184,6 +187,15 @@ std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState&
   if (dp > config.max_position_difference)
     return fmt::format("the VIS's motion differs from the IMU's prediction by {:.2f} m", dp);
   return {};
+}
+
+// The accelerometer reads f = R^T (a - g) + b_a: the body-frame acceleration is f - b_a + R^T g by either estimate.
+std::string accelerationDisagreement(const VisualIncrement& inc, const imu::NavState& b, double gravity,
+                                     const Eigen::Vector3d& lis_acc_bias, const VisualMotionConfig& config) {
+  const Eigen::Vector3d gravity_lis = b.T_world_imu.linear().transpose() * Eigen::Vector3d(0, 0, -gravity);
+  const double da = ((inc.gravity_b - gravity_lis) - (inc.acc_bias_b - lis_acc_bias)).norm();
+  if (da <= config.max_acceleration_difference) return {};
+  return fmt::format("the VIS's attitude and accelerometer bias make {:.3f} m/s^2 more of the IMU than the LIS's", da);
 }
 
 }  // namespace drover::pipeline

@@ -341,3 +341,52 @@ TEST(VisualMotion, AKeyframeGapIsAStallOnlyWhenTheLisMovedOverIt) {
 }
 
 }  // namespace drover::pipeline
+
+namespace drover::pipeline {
+
+// The VIS's and the LIS's attitudes and accelerometer biases, as a body-frame acceleration made of the same specific
+// force: a tilt its bias does not offset accelerates the VIS against the LIS at g sin(tilt).
+TEST(VisualMotion, AVisTiltedAgainstTheLisIsRefusedUnlessItsAccelerometerBiasOffsetsTheTilt) {
+  constexpr double kG = 9.81;
+  const Eigen::Matrix3d R_lis = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const imu::NavState b{10 * kSec, Eigen::Isometry3d(R_lis), R_lis * Eigen::Vector3d(1, 0, 0)};
+  const Eigen::Vector3d lis_bias(0.01, -0.02, 0.01);
+  const Eigen::Vector3d g_world(0, 0, -kG);
+  // The VIS's world is turned 90 deg from the LIS's about gravity (its own yaw): only the tilt counts.
+  const auto visTilted = [&](double pitch_deg) {
+    VisualIncrement inc;
+    const Eigen::Matrix3d R_vis = Eigen::AngleAxisd(0.4 + M_PI / 2, Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(pitch_deg * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    inc.gravity_b = R_vis.transpose() * g_world;
+    inc.acc_bias_b = lis_bias;
+    return inc;
+  };
+  const VisualMotionConfig c;  // 0.08 m/s^2
+  EXPECT_EQ(accelerationDisagreement(visTilted(0), b, kG, lis_bias, c), "");
+  EXPECT_EQ(accelerationDisagreement(visTilted(0.3), b, kG, lis_bias, c), "") << "0.051 m/s^2";
+  // The corridor's re-initialised VIS: 0.77 deg with the LIS's bias, 0.132 m/s^2.
+  const std::string why = accelerationDisagreement(visTilted(0.77), b, kG, lis_bias, c);
+  EXPECT_NE(why.find("0.132 m/s^2"), std::string::npos) << why;
+  // The same tilt with a bias that offsets it (a straight drive cannot tell the two apart): the same motion.
+  VisualIncrement offset = visTilted(0.77);
+  offset.acc_bias_b = lis_bias + (offset.gravity_b - R_lis.transpose() * g_world);
+  EXPECT_EQ(accelerationDisagreement(offset, b, kG, lis_bias, c), "");
+  // Level, with a bias 0.1 m/s^2 off the LIS's.
+  VisualIncrement biased = visTilted(0);
+  biased.acc_bias_b += Eigen::Vector3d(0, 0.1, 0);
+  EXPECT_NE(accelerationDisagreement(biased, b, kG, lis_bias, c), "");
+}
+
+TEST(VisualMotion, TheIncrementCarriesTheVisGravityAndAccelerometerBiasAtTheLaterStamp) {
+  const Time a = 5 * kSec + 30'000'000, b = a + kSec / 10;
+  const VisualMotion m = motionWithFrames(b + 20'000'000);
+  std::string why;
+  const std::optional<VisualIncrement> inc = m.increment(a, b, course().propagator(b + 20'000'000), &why);
+  ASSERT_TRUE(inc) << why;
+  const Eigen::Matrix3d R_b = course().path.at(b).T_world_body.linear();
+  const Eigen::Vector3d g_b = R_b.transpose() * Eigen::Vector3d(0, 0, -course().preintegration.gravity);
+  EXPECT_LT((inc->gravity_b - g_b).norm(), 1e-4) << "pitch and roll vary along the path";
+  EXPECT_EQ(inc->acc_bias_b, Eigen::Vector3d::Zero());
+}
+
+}  // namespace drover::pipeline

@@ -31,14 +31,16 @@ struct FusedRun {
   Trajectory vis;                  // the VIS's own T_world_imu at every frame it estimated
   Time first_vis_factor = 0;        // [ns] the first sweep with the VIS's motion as a factor (0: none)
   std::size_t keyframe_gap_refusals = 0;  // sweeps the keyframe gate refused the VIS ("no keyframe for ...")
+  std::size_t acceleration_refusals = 0;  // sweeps refused by max_acceleration_difference (its tilt and bias)
 };
 
 // The replay of `course` up to `until` (0: all of it); with `factor` false the VIS's motion is only the matcher's
 // guess (drover run --without vo-factor); `tweak` changes the platform file's odometry settings, `vio_tweak` its
-// VIS settings.
+// VIS settings, `detector_tweak` its detector (Shi-Tomasi unless it says otherwise).
 inline FusedRun runFused(const LiveCourse& course, Time until = 0, bool factor = true,
                          const std::function<void(pipeline::OdometryConfig&)>& tweak = {},
-                         const std::function<void(vio::VioConfig&)>& vio_tweak = {}) {
+                         const std::function<void(vio::VioConfig&)>& vio_tweak = {},
+                         const std::function<void(visual::DetectorConfig&)>& detector_tweak = {}) {
   const std::string yaml = std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml";
   pipeline::OdometryConfig odometry_config = io::loadOdometryConfig(yaml);
   odometry_config.vis_fusion.factor = factor;
@@ -52,6 +54,7 @@ inline FusedRun runFused(const LiveCourse& course, Time until = 0, bool factor =
   vis_config.depth = visual.depth;
   visual::DetectorConfig detector = visual.detector;
   detector.type = visual::DetectorType::kShiTomasi;  // SuperPoint costs ~0.4 s a frame here
+  if (detector_tweak) detector_tweak(detector);
   vio::VisualOdometry vo(vis_config, course.calibration, odometry_config.preintegration, visual::makeDetector(detector));
   lis.setSweepListener([&](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {
     vo.addSweep(t, T, p);
@@ -81,6 +84,7 @@ inline FusedRun runFused(const LiveCourse& course, Time until = 0, bool factor =
       if (o.has_imu_state) lis_bias = imu::ImuBias{o.gyro_bias, o.acc_bias};
       if (o.vis_factor && r.first_vis_factor == 0) r.first_vis_factor = o.t;
       if (o.vis_unused.find("no keyframe for") != std::string::npos) ++r.keyframe_gap_refusals;
+      if (o.vis_unused.find("accelerometer bias make") != std::string::npos) ++r.acceleration_refusals;
       if (!o.vis_reset.empty() && vo.estimator().initialized()) {
         vo.reset();
         ++r.resets_by_the_lis;

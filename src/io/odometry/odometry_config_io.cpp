@@ -129,6 +129,7 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bind("keyframe_gap_min_distance", c.keyframe_gap_min_distance)
       .bind("max_velocity_difference", c.max_velocity_difference)
       .bind("max_position_difference", c.max_position_difference)
+      .bind("max_acceleration_difference", c.max_acceleration_difference)
       .bindSeconds("reset_after", c.reset_after, atLeast(0, "s"));
 }
 

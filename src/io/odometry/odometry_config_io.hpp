@@ -24,7 +24,8 @@
 //                   window_covariance (bool), window_floor_position [m], window_floor_rotation [rad], min_features,
 //                   full_features, warmup [s], max_age [s], max_keyframe_gap [s], standing_speed [m/s],
 //                   keyframe_gap_min_distance [m], max_velocity_difference [m/s],
-//                   max_position_difference [m], reset_after [s] (pipeline/visual_motion.hpp)
+//                   max_position_difference [m], max_acceleration_difference [m/s^2], reset_after [s]
+//                   (pipeline/visual_motion.hpp)
 //   loop: (its own top-level section) see io/odometry/loop_config_io.hpp
 // Lives in its own library (drover_io_odometry) so that the readers do not depend on the odometry modules.
 #include <string>
