@@ -195,7 +195,8 @@ std::string accelerationDisagreement(const VisualIncrement& inc, const imu::NavS
   const Eigen::Vector3d gravity_lis = b.T_world_imu.linear().transpose() * Eigen::Vector3d(0, 0, -gravity);
   const double da = ((inc.gravity_b - gravity_lis) - (inc.acc_bias_b - lis_acc_bias)).norm();
   if (da <= config.max_acceleration_difference) return {};
-  return fmt::format("the VIS's attitude and accelerometer bias make {:.3f} m/s^2 more of the IMU than the LIS's", da);
+  return fmt::format("the VIS's attitude and accelerometer bias make an acceleration {:.3f} m/s^2 off the LIS's of the "
+                     "same IMU reading", da);
 }
 
 }  // namespace drover::pipeline
