@@ -355,8 +355,9 @@ TEST(VisualMotion, AVisTiltedAgainstTheLisIsRefusedUnlessItsAccelerometerBiasOff
   // The VIS's world is turned 90 deg from the LIS's about gravity (its own yaw): only the tilt counts.
   const auto visTilted = [&](double pitch_deg) {
     VisualIncrement inc;
-    const Eigen::Matrix3d R_vis = Eigen::AngleAxisd(0.4 + M_PI / 2, Eigen::Vector3d::UnitZ()) *
-                                  Eigen::AngleAxisd(pitch_deg * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Matrix3d R_vis =
+        Eigen::AngleAxisd(0.4 + M_PI / 2, Eigen::Vector3d::UnitZ()) *
+        Eigen::AngleAxisd(pitch_deg * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
     inc.gravity_b = R_vis.transpose() * g_world;
     inc.acc_bias_b = lis_bias;
     return inc;
