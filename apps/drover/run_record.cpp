@@ -18,6 +18,12 @@ constexpr double kLowest = 1e-4, kHighest = 1e7, kRatio = 1.01;  // the histogra
 
 Json vectorJson(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
+Json vectorJson(const Eigen::Matrix<double, 6, 1>& v) {
+  Json out = Json::array();
+  for (int i = 0; i < 6; ++i) out.push_back(std::round(v(i) * 1e4) / 1e4);  // 4 decimals: a direction, not a value
+  return out;
+}
+
 }  // namespace
 
 std::size_t BoundedQuantiles::bin(double v) {
@@ -89,14 +95,22 @@ Json SweepLog::line(const pipeline::ScanOutcome& s) {
             {"planes", s.planes},
             {"keyframe", s.keyframe},
             {"degenerate", s.degenerate_count},
+            {"min_eigenvalue", std::round(s.min_eigenvalue * 10) / 10},
             {"imu", s.imu_used},
             {"reset", s.reset},
             {"total_ms", s.ms.total}};
   // With a VIS: whether its motion was the matcher's guess and a smoother factor, or why it was not used.
+  // Each degenerate direction of the match: a unit vector in the lidar's tangent [rho (m); phi (rad)].
+  if (!s.degenerate_directions.empty()) {
+    Json dirs = Json::array();
+    for (const auto& d : s.degenerate_directions) dirs.push_back(vectorJson(d));
+    j["degenerate_directions"] = dirs;
+  }
   if (s.vis_guess) j["vis_guess"] = true;
   if (s.vis_factor) j["vis_factor"] = true;
   if (!s.vis_unused.empty()) j["vis_unused"] = s.vis_unused;
   if (!s.vis_reset.empty()) j["vis_reset"] = s.vis_reset;
+  if (!s.warning.empty()) j["warning"] = s.warning;
   if (s.has_imu_state) {
     j["v_world"] = vectorJson(s.v_world);      // [m/s]
     j["gyro_bias"] = vectorJson(s.gyro_bias);  // [rad/s], IMU frame

@@ -40,7 +40,8 @@ class BoundedQuantiles {
 };
 
 // report.json's per-sweep lines (one JSON object a line: t, status, iterations, fitness_m, inliers, points,
-// features, keyframe, degenerate, imu, reset, total_ms, and with the IMU v_world / gyro_bias / acc_bias).
+// features, keyframe, degenerate, min_eigenvalue, imu, reset, total_ms; degenerate_directions on a degenerate sweep,
+// warning on a sweep with one, and with the IMU v_world / gyro_bias / acc_bias).
 class SweepLog {
  public:
   // Each line written to `path` as it comes (drover run: OUT.partial/sweeps.jsonl). Throws IoError.

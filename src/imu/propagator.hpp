@@ -44,7 +44,11 @@ class ImuPropagator {
     double max_gap_s = 0.1;    // [s] an interval longer than this between accepted samples is reported as a gap
     double max_acc = 150.0;    // [m/s^2] specific-force norm above this is a spike (~15 g)
     double max_gyro = 35.0;    // [rad/s] rate norm above this is a spike (~2000 deg/s)
-    double buffer_s = 5.0;     // [s] samples older than the newest minus this are discarded
+    // [s] samples older than the newest minus this are discarded. The smoother bridges a lidar dropout with the IMU
+    // factor over these samples; past them it restarts. At 5 s the farm's 5 s lidar dropout fell just outside (the
+    // sweep after it starts 5.1 s after the one before), and the restart re-estimated both biases from loose priors.
+    // 20 s at 200 Hz is 4,000 samples (~0.4 MB with the propagated states).
+    double buffer_s = 20.0;
     double gravity = 9.81;     // [m/s^2] world gravity is (0, 0, -gravity)
     // Empty when valid: all values finite and > 0.
     std::string validate() const;

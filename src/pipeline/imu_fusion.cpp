@@ -142,6 +142,18 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
   }
 }
 
+// The biases' covariance after `gap` seconds without the IMU in the smoother: the window's, grown by the random walk
+// over the gap (Forster Eq. 48). The biases are body-frame quantities a gap does not move, so a restart across one
+// keeps what the window knew of them instead of re-centring the loose first-state priors (0.01 rad/s, 0.1 m/s^2).
+std::optional<Eigen::Matrix<double, 6, 6>> ImuFusion::biasCovarianceAfter(double gap) const {
+  std::optional<Eigen::Matrix<double, 6, 6>> C = smoother_.biasCovariance();
+  if (!C || !(gap > 0)) return C;
+  const double g = config_.preintegration.gyro_bias_random_walk, a = config_.preintegration.acc_bias_random_walk;
+  C->diagonal().head<3>().array() += g * g * gap;
+  C->diagonal().tail<3>().array() += a * a * gap;
+  return C;
+}
+
 bool ImuFusion::restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3d& T_world_imu_measured,
                                         const Trajectory& trajectory) {
   // Counts down to the configured sweep, then below zero through the retries a sweep without a lidar velocity
@@ -201,7 +213,8 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   if (samples.empty()) {
     appendWarning(out, "IMU does not cover the sweep: smoother restarted at the lidar pose");
     out.reset = true;
-    restart({out.t, T_world_imu_measured, velocityFrom(trajectory, T_lidar_imu_)}, smoother_.bias());
+    restart({out.t, T_world_imu_measured, velocityFrom(trajectory, T_lidar_imu_)}, smoother_.bias(), std::nullopt,
+            biasCovarianceAfter(toSeconds(out.t - previous.t)));
     return;
   }
   const Eigen::Matrix<double, 6, 6> L = poseSqrtInformation(out, T_world_imu_measured);

@@ -89,6 +89,7 @@ class ImuFusion {
   bool restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3d& T_world_imu_measured,
                                const Trajectory& trajectory);
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
+  std::optional<Eigen::Matrix<double, 6, 6>> biasCovarianceAfter(double gap) const;
 
   OdometryConfig config_;
   Eigen::Isometry3d T_imu_lidar_, T_lidar_imu_;

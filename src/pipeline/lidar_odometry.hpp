@@ -49,6 +49,7 @@ struct ScanOutcome {
   bool degenerate = false;
   int degenerate_count = 0;       // degenerate directions of the match
   std::vector<Eigen::Matrix<double, 6, 1>> degenerate_directions;  // unit, lidar tangent [rho; phi]
+  double min_eigenvalue = 0;      // [-] smallest eigenvalue of the match's J^T J (matcher.degeneracy_threshold's units)
   int iterations = 0;
   double fitness = 0;             // [m] RMS point-to-feature distance
   int edge_inliers = 0, plane_inliers = 0;

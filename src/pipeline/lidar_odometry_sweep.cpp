@@ -188,6 +188,7 @@ void LidarOdometry::Impl::match(const lidar::FeatureSet& features, const Eigen::
   out.degenerate = r.degenerate;
   out.degenerate_count = r.degenerate_count;
   out.degenerate_directions = r.degenerate_directions;
+  out.min_eigenvalue = r.eigenvalues.minCoeff();
   out.iterations = r.iterations;
   out.fitness = r.fitness;
   out.edge_inliers = r.edge_inliers;

@@ -84,6 +84,39 @@ TEST(SweepLog, StreamsEveryLineToItsFileOrKeepsOnlyTheNewest) {
   EXPECT_STREQ(RunRecord::stageNames()[7], "total");
 }
 
+// A degenerate sweep says which directions the lidar left to the IMU and how weakly it held the weakest (the number
+// matcher.degeneracy_threshold is compared with), and a sweep with a problem carries its warning (a smoother
+// restart's reason); a healthy sweep carries neither.
+TEST(SweepLog, ALineNamesTheDegenerateDirectionsTheSmallestEigenvalueAndTheWarning) {
+  const test::TempDir dir;
+  RunRecord record;
+  record.log.streamTo((dir / "sweeps.jsonl").string());
+  pipeline::ScanOutcome degenerate = sweepAt(1, true);
+  degenerate.degenerate = true;
+  degenerate.degenerate_count = 1;
+  degenerate.degenerate_directions = {(Eigen::Matrix<double, 6, 1>() << 0.99995, 0.01, 0, 0, 0, 0.0001).finished()};
+  degenerate.min_eigenvalue = 22.37;
+  degenerate.warning = "IMU does not cover the sweep: smoother restarted at the lidar pose";
+  record.add(degenerate);
+  pipeline::ScanOutcome healthy = sweepAt(2, true);
+  healthy.min_eigenvalue = 512.0;
+  record.add(healthy);
+  record.log.finish((dir / "unused.jsonl").string());
+  const nlohmann::json lines = test::readJsonLines(dir / "sweeps.jsonl");
+  ASSERT_EQ(lines.size(), 2u);
+  ASSERT_EQ(lines[0]["degenerate_directions"].size(), 1u);
+  const std::vector<double> d = lines[0]["degenerate_directions"][0].get<std::vector<double>>();
+  ASSERT_EQ(d.size(), 6u);
+  EXPECT_DOUBLE_EQ(d[0], 1.0) << "a direction is written to 4 decimals";
+  EXPECT_DOUBLE_EQ(d[1], 0.01);
+  EXPECT_DOUBLE_EQ(d[5], 0.0001);
+  EXPECT_DOUBLE_EQ(lines[0]["min_eigenvalue"].get<double>(), 22.4);
+  EXPECT_EQ(lines[0]["warning"], degenerate.warning);
+  EXPECT_FALSE(lines[1].contains("degenerate_directions"));
+  EXPECT_FALSE(lines[1].contains("warning"));
+  EXPECT_DOUBLE_EQ(lines[1]["min_eigenvalue"].get<double>(), 512.0);
+}
+
 TEST(ImuRateFile, StreamsPosesInTheBodyFrameSkipsRepeatsAndCopiesWhatItHasSoFar) {
   const test::TempDir dir;
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();

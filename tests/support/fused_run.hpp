@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct FusedRun {
   Time first_vis_factor = 0;        // [ns] the first sweep with the VIS's motion as a factor (0: none)
   std::size_t keyframe_gap_refusals = 0;  // sweeps the keyframe gate refused the VIS ("no keyframe for ...")
   std::size_t acceleration_refusals = 0;  // sweeps refused by max_acceleration_difference (its tilt and bias)
+  std::vector<std::pair<Time, imu::ImuBias>> biases;  // the smoother's newest biases after each sweep that ran it
+  std::vector<Time> resets;                           // sweeps where the smoother restarted
 };
 
 // The replay of `course` up to `until` (0: all of it); with `factor` false the VIS's motion is only the matcher's
@@ -81,7 +84,11 @@ inline FusedRun runFused(const LiveCourse& course, Time until = 0, bool factor =
     }
     if (const auto* imu = std::get_if<ImuSample>(&m)) vo.addImu(*imu);
     for (const pipeline::ScanOutcome& o : lis.process(m)) {
-      if (o.has_imu_state) lis_bias = imu::ImuBias{o.gyro_bias, o.acc_bias};
+      if (o.has_imu_state) {
+        lis_bias = imu::ImuBias{o.gyro_bias, o.acc_bias};
+        r.biases.emplace_back(o.t, *lis_bias);
+      }
+      if (o.reset) r.resets.push_back(o.t);
       if (o.vis_factor && r.first_vis_factor == 0) r.first_vis_factor = o.t;
       if (o.vis_unused.find("no keyframe for") != std::string::npos) ++r.keyframe_gap_refusals;
       if (o.vis_unused.find("accelerometer bias make") != std::string::npos) ++r.acceleration_refusals;
