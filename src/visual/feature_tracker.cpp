@@ -24,6 +24,8 @@ std::string FeatureTrackerConfig::validate() const {
   if (flow_levels < 0 || flow_levels > 8) return "flow_levels must be in [0, 8], got " + std::to_string(flow_levels);
   if (flow_iterations < 1) return "flow_iterations must be >= 1, got " + std::to_string(flow_iterations);
   if (!(flow_epsilon > 0)) return "flow_epsilon must be > 0, got " + std::to_string(flow_epsilon);
+  if (!(min_eigenvalue >= 0) || !std::isfinite(min_eigenvalue))
+    return "min_eigenvalue must be finite and >= 0, got " + std::to_string(min_eigenvalue);
   if (!(forward_backward_px > 0)) return "forward_backward_px must be > 0, got " + std::to_string(forward_backward_px);
   if (border_px < 0) return "border_px must be >= 0, got " + std::to_string(border_px);
   if (!(ransac_threshold_px > 0)) return "ransac_threshold_px must be > 0, got " + std::to_string(ransac_threshold_px);
@@ -139,7 +141,7 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
   std::vector<unsigned char> status;
   std::vector<float> error;
   cv::calcOpticalFlowPyrLK(previous_gray_, gray, tracks_.pixels, current, status, error, window, config_.flow_levels,
-                           criteria);
+                           criteria, 0, config_.min_eigenvalue);
   std::vector<unsigned char> back_status(status.size(), 1);
   std::vector<cv::Point2f> back;
   if (config_.forward_backward) {

@@ -35,6 +35,14 @@ struct FeatureTrackerConfig {
   int flow_levels = 3;              // pyramid levels above the image (cv::calcOpticalFlowPyrLK maxLevel)
   int flow_iterations = 30;         // LK iterations per level
   double flow_epsilon = 0.01;       // [px] LK convergence
+  // cv::calcOpticalFlowPyrLK's minEigThreshold: a track is lost where the smallest eigenvalue of its window's
+  // gradient matrix (per pixel, intensities in [0, 1]) falls below this. On a plain surface the window sees only
+  // noise or an edge, along which LK slides (the aperture problem): SuperPoint at a low confidence keeps such points
+  // on a textureless wall, and a VIS re-initialised on their sliding tracks tilted itself 0.8 deg (bench/RESULTS.md).
+  // The scale is the camera's: measured over tracked features, the simulated camera's textured surfaces
+  // 5.5e-3 / 9e-3 (p10 / p50), its textureless ones 3e-4 / 4.5e-4; EuRoC's real frames 1.5e-3 / 1.3e-2. So it is a
+  // platform setting; every shipped platform file keeps OpenCV's default for now (2e-3 on the farm: bench/RESULTS.md).
+  double min_eigenvalue = 1e-4;
   bool forward_backward = true;     // track back and drop points that do not return
   double forward_backward_px = 0.5;  // [px] largest forward-backward distance kept
   int border_px = 1;                // [px] points closer to the image edge are dropped (VINS-Mono inBorder)

@@ -82,7 +82,9 @@ std::vector<cv::Point2f> carry(std::vector<cv::Point2f> points, const cv::Mat& f
     if (live.empty()) break;
     std::vector<unsigned char> status, back_status(live.size(), 1);
     std::vector<float> error;
-    cv::calcOpticalFlowPyrLK(previous, frame, live, next, status, error, window, config.flow_levels);
+    cv::calcOpticalFlowPyrLK(previous, frame, live, next, status, error, window, config.flow_levels,
+                             cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 30, 0.01), 0,
+                             config.min_eigenvalue);
     std::vector<cv::Point2f> back = live;
     if (config.forward_backward)
       cv::calcOpticalFlowPyrLK(frame, previous, next, back, back_status, error, window, config.flow_levels,

@@ -137,6 +137,7 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
     flow_levels: 2
     flow_iterations: 20
     flow_epsilon: 0.02
+    min_eigenvalue: 0.003
     forward_backward: false
     forward_backward_px: 0.75
     border_px: 3
@@ -161,6 +162,7 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
   EXPECT_EQ(t.flow_levels, 2);
   EXPECT_EQ(t.flow_iterations, 20);
   EXPECT_DOUBLE_EQ(t.flow_epsilon, 0.02);
+  EXPECT_DOUBLE_EQ(t.min_eigenvalue, 0.003);
   EXPECT_FALSE(t.forward_backward);
   EXPECT_DOUBLE_EQ(t.forward_backward_px, 0.75);
   EXPECT_EQ(t.border_px, 3);

@@ -54,6 +54,7 @@ void bindTracker(YamlSection& s, visual::FeatureTrackerConfig& c, std::string& c
       .bind("flow_levels", c.flow_levels)
       .bind("flow_iterations", c.flow_iterations)
       .bind("flow_epsilon", c.flow_epsilon)
+      .bind("min_eigenvalue", c.min_eigenvalue)
       .bind("forward_backward", c.forward_backward)
       .bind("forward_backward_px", c.forward_backward_px)
       .bind("border_px", c.border_px)

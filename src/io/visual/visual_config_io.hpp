@@ -10,7 +10,8 @@
 //                     input_width, input_height [px], max_keypoints, confidence_threshold, nms_radius [px],
 //                     border [px], threads, min_keypoints (floor below the threshold; 0 = off)
 //     tracker:        max_features, min_distance [px], flow_window [px], flow_levels, flow_iterations,
-//                     flow_epsilon [px], forward_backward (bool), forward_backward_px [px], border_px [px],
+//                     flow_epsilon [px], min_eigenvalue (LK's minEigThreshold), forward_backward (bool),
+//                     forward_backward_px [px], border_px [px],
 //                     ransac (bool), ransac_threshold_px [px at virtual_focal_px], ransac_confidence,
 //                     virtual_focal_px [px], clahe (off | always | when_dark), clahe_clip, clahe_tiles,
 //                     dark_mean [grey levels], async_detection (bool), detect_below, detect_interval_s [s],
