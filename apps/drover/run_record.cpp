@@ -99,13 +99,13 @@ Json SweepLog::line(const pipeline::ScanOutcome& s) {
             {"imu", s.imu_used},
             {"reset", s.reset},
             {"total_ms", s.ms.total}};
-  // With a VIS: whether its motion was the matcher's guess and a smoother factor, or why it was not used.
   // Each degenerate direction of the match: a unit vector in the lidar's tangent [rho (m); phi (rad)].
   if (!s.degenerate_directions.empty()) {
     Json dirs = Json::array();
     for (const auto& d : s.degenerate_directions) dirs.push_back(vectorJson(d));
     j["degenerate_directions"] = dirs;
   }
+  // With a VIS: whether its motion was the matcher's guess and a smoother factor, or why it was not used.
   if (s.vis_guess) j["vis_guess"] = true;
   if (s.vis_factor) j["vis_factor"] = true;
   if (!s.vis_unused.empty()) j["vis_unused"] = s.vis_unused;
