@@ -225,6 +225,8 @@ TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
   EXPECT_TRUE(has(e, "line 3")) << e;
   EXPECT_TRUE(has(e, "visual.tracker")) << e;
   EXPECT_TRUE(has(e, "flow_window must be odd")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    min_eigenvalue: -0.001\n");
+  EXPECT_TRUE(has(e, "line 3") && has(e, "min_eigenvalue must be finite and >= 0")) << e;
   e = errorOf(dir, "visual:\n  tracker:\n    detect_interval_s: -1\n");
   EXPECT_TRUE(has(e, "line 3") && has(e, "detect_interval_s must be in [0, 60] s")) << e;
   e = errorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
