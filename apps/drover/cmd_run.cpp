@@ -139,7 +139,7 @@ void checkSomethingWasDone(const pipeline::OdometryStats& s, const RunOptions& o
     if (vis == nullptr || vis->framesIn() == 0)
       throw std::invalid_argument("dataset " + o.dataset + " has no camera frames" + window +
                                   ": drover run --no-lidar runs the VIS, which needs a camera and an IMU");
-    if (vis->trajectory().empty())
+    if (vis->framesEstimated() == 0)
       throw std::invalid_argument(fmt::format("{}: the VIS did not initialise in {} camera frames{}: {}", o.dataset,
                                               vis->framesIn(), window, vis->waitingReason()));
     return;
@@ -195,6 +195,7 @@ void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& co
                      o.method().describe()};
   RealtimeRun run;
   streamRunFiles(context, run.record, config.use_imu);
+  if (vis) streamVisFiles(context, *vis);
   runRealtime(reader, system_config, options, stop, run);
   if (vis && vis->framesIn() == 0) vis.reset();  // no camera frames came: no VIS files
   const pipeline::LidarOdometry& lis = run.system->lis();
@@ -285,6 +286,7 @@ void runOdometry(const RunOptions& o) {
   const auto visFor = [&]() -> RunVis& {
     if (!vis) {
       vis = std::make_unique<RunVis>(*vis_setup, reader->calibration(), config.preintegration);
+      streamVisFiles(context, *vis);
       if (last_imu) vis->onImu(*last_imu);  // the first frame's interval starts at the sample before it
       if (!no_lidar)
         odometry.setSweepListener([&vis](Time t, const Eigen::Isometry3d& T, const std::vector<Eigen::Vector3f>& p) {

@@ -12,8 +12,8 @@ namespace fs = std::filesystem;
 // tools/course_report.py adds to it (scripts/run.sh), which describes the run it replaces.
 constexpr const char* kRunFiles[] = {"trajectory.tum",  "trajectory_kitti.txt", "keyframes.tum",
                                      "trajectory_imu_rate.tum", "trajectory_vis.tum", "map.pcd",
-                                     "map.ply", "report.json", "sweeps.jsonl", "ape.json", "ape.png",
-                                     "course_report.json"};
+                                     "map.ply", "report.json", "sweeps.jsonl", "vis_frames.jsonl", "ape.json",
+                                     "ape.png", "course_report.json"};
 
 bool isRunFile(const std::string& name) {
   for (const char* f : kRunFiles)

@@ -13,6 +13,7 @@
 #include "eval/ape.hpp"
 #include "geometry/trajectory_fill.hpp"
 #include "io/cloud_io.hpp"
+#include "io/error.hpp"
 #include "io/kitti_common.hpp"
 #include "io/trajectory_io.hpp"
 
@@ -33,12 +34,9 @@ Trajectory inBodyFrame(const Trajectory& lidar, const RunContext& c) {
   return out;
 }
 
-// IMU-rate T_world_imu -> T_world_body in the frame of trajectory.tum (the lidar when the body is not the IMU).
-Trajectory imuRateInBodyFrame(const Trajectory& imu, const RunContext& c) {
-  if (c.ground_truth.body_frame == "imu") return imu;
-  Trajectory out = imu;
-  for (auto& p : out) p.T_world_body = p.T_world_body * c.calibration.T_imu_lidar;
-  return out;
+// T_imu_body of trajectory.tum's body frame: the IMU's, or the lidar's when the body is not the IMU.
+Eigen::Isometry3d imuToBody(const RunContext& c) {
+  return c.ground_truth.body_frame == "imu" ? Eigen::Isometry3d::Identity() : c.calibration.T_imu_lidar;
 }
 
 // KITTI devkit frame: T_cam0(0)_cam0(i) = Tr T_lidar0_lidar_i Tr^-1 with Tr = T_cam0_lidar from calib.txt. One line
@@ -174,16 +172,15 @@ double pathLength(const Trajectory& poses) {  // [m]
   return length;
 }
 
-// The VIS's T_world_imu per camera frame -> trajectory_vis.tum in trajectory.tum's body frame; returns report.json's
-// "vis" section with the VIS's own translation APE (SE(3)-aligned) when there is ground truth, printed as evo does.
-Json writeVisTrajectory(const RunContext& c, const RunVis& vis) {
+// The VIS's streamed files finished into the folder; returns report.json's "vis" section with the VIS's own
+// translation APE (SE(3)-aligned, the trajectory read back) when there is ground truth, printed as evo does.
+Json finishVisFiles(const RunContext& c, RunVis& vis) {
   Json j = vis.report();
-  const Trajectory est = imuRateInBodyFrame(vis.trajectory(), c);
-  if (est.empty()) return j;
-  io::writeTum(inRun(c, "trajectory_vis.tum"), est);
-  if (c.ground_truth.poses.empty() || est.size() < 3) return j;
+  const ImuRateFile::Summary s = vis.finishFiles();
+  if (s.poses < 3 || c.ground_truth.poses.empty()) return j;
   try {
-    const eval::ApeResult a = eval::computeApe(c.ground_truth.poses, est, se3ApeOptions());
+    const eval::ApeResult a =
+        eval::computeApe(c.ground_truth.poses, io::readTum(inRun(c, "trajectory_vis.tum")), se3ApeOptions());
     if (spdlog::should_log(spdlog::level::info)) fmt::print("VIS {}\n\n{}\n", apeTitle(a), statisticsTable(a.stats));
     j["ape"] = statisticsJson(a.stats);
     const double length = pathLength(c.ground_truth.poses);
@@ -196,9 +193,7 @@ Json writeVisTrajectory(const RunContext& c, const RunVis& vis) {
 
 }  // namespace
 
-void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& r) {
-  const Trajectory est = imuRateInBodyFrame(vis.trajectory(), c);
-  io::writeTum(inRun(c, "trajectory.tum"), est);
+void writeVisRunFolder(const RunContext& c, RunVis& vis, const RunRecord& r) {
   Json report;
   report["dataset"] = c.dataset;
   report["format"] = c.format;
@@ -208,27 +203,34 @@ void writeVisRunFolder(const RunContext& c, const RunVis& vis, const RunRecord& 
   report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};
   report["body_frame"] = c.ground_truth.body_frame.empty() ? "imu" : c.ground_truth.body_frame;
   report["wall_s"] = r.wall_s;
+  report["vis"] = finishVisFiles(c, vis);  // trajectory_vis.tum complete from here
+  const std::string vis_path = inRun(c, "trajectory_vis.tum"), path = inRun(c, "trajectory.tum");
+  std::error_code e;  // trajectory.tum is the VIS's here, byte for byte
+  fs::copy_file(vis_path, path, fs::copy_options::overwrite_existing, e);
+  if (e) throw io::IoError(path, "", "cannot copy the VIS trajectory from " + vis_path + ": " + e.message());
+  const Trajectory est = io::readTum(path);
   const double data_s = est.size() > 1 ? toSeconds(est.back().t - est.front().t) : 0.0;
   report["data_s"] = data_s;
   report["real_time_factor"] = r.wall_s > 0 ? data_s / r.wall_s : 0.0;
   report["counts"] = {{"measurements_dropped", r.measurements_dropped}};
   report["ape"] = evaluate(c, est);
-  report["vis"] = writeVisTrajectory(c, vis);
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("VIS: {} of {} camera frames estimated, {} resets, in {:.1f} s: {:.1f}x real time; results in {}",
                est.size(), vis.framesIn(), report["vis"]["resets"].get<std::size_t>(), r.wall_s,
                r.wall_s > 0 ? data_s / r.wall_s : 0.0, c.out);
 }
 
+void streamVisFiles(const RunContext& c, RunVis& vis) {
+  vis.streamTo(inRun(c, "vis_frames.jsonl"), inRun(c, "trajectory_vis.tum"), imuToBody(c));
+}
+
 void streamRunFiles(const RunContext& c, RunRecord& r, bool imu) {
   r.log.streamTo(inRun(c, "sweeps.jsonl"));
   if (!imu) return;
-  const bool imu_body = c.ground_truth.body_frame == "imu";
-  r.imu_rate = std::make_shared<ImuRateFile>(inRun(c, "trajectory_imu_rate.tum"),
-                                             imu_body ? Eigen::Isometry3d::Identity() : c.calibration.T_imu_lidar);
+  r.imu_rate = std::make_shared<ImuRateFile>(inRun(c, "trajectory_imu_rate.tum"), imuToBody(c));
 }
 
-void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, RunRecord& r, const RunVis* vis,
+void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry, RunRecord& r, RunVis* vis,
                     const LiveRun* live) {
   const Trajectory est = inBodyFrame(odometry.trajectory(), c);
   if (!est.empty()) {
@@ -263,8 +265,8 @@ void writeRunFolder(const RunContext& c, const pipeline::LidarOdometry& odometry
   if (live != nullptr && !live->realtime.is_null()) report["realtime"] = live->realtime;
   if (odometry.config().use_imu) report["imu_rate"] = finishImuRate(c, r);
   if (!kitti.is_null()) report["trajectory_kitti"] = kitti;
-  if (vis != nullptr) report["vis"] = writeVisTrajectory(c, *vis);
-  report["mode"] = std::string(report["mode"]) + (vis != nullptr && !vis->trajectory().empty() ? "+camera" : "");
+  if (vis != nullptr) report["vis"] = finishVisFiles(c, *vis);
+  report["mode"] = std::string(report["mode"]) + (vis != nullptr && vis->framesEstimated() > 0 ? "+camera" : "");
   report["sweeps_logged"] = r.log.lines();  // sweeps.jsonl's lines
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("{} sweeps ({} keyframes, {} degenerate, {} resets) in {:.1f} s: {:.1f}x real time; results in {}",

@@ -45,12 +45,16 @@ struct LiveRun {
 // Writes every file above (each atomically) and prints the APE table. Throws IoError when a file cannot be
 // written.
 // vis: the VIS when it ran beside the LIS (nullptr otherwise); live: set for a --realtime run.
-// record.log and record.imu_rate are finished into the folder (closed, or copied there when streamed elsewhere).
+// record.log, record.imu_rate and the VIS's streamed files are finished into the folder (closed, or copied there
+// when streamed elsewhere).
 void writeRunFolder(const RunContext& context, const pipeline::LidarOdometry& odometry, RunRecord& record,
-                    const RunVis* vis, const LiveRun* live = nullptr);
+                    RunVis* vis, const LiveRun* live = nullptr);
 // Before a run: its per-sweep lines and (with the IMU) its IMU-rate odometry streamed into context.dir.
 void streamRunFiles(const RunContext& context, RunRecord& record, bool imu);
-// --no-lidar: the VIS alone (trajectory.tum, trajectory_vis.tum, report.json, ape.json/png).
-void writeVisRunFolder(const RunContext& context, const RunVis& vis, const RunRecord& record);
+// Before the VIS's first frame: its per-frame lines (vis_frames.jsonl) and its trajectory (trajectory_vis.tum, in
+// trajectory.tum's body frame) streamed into context.dir.
+void streamVisFiles(const RunContext& context, RunVis& vis);
+// --no-lidar: the VIS alone (trajectory.tum, trajectory_vis.tum, vis_frames.jsonl, report.json, ape.json/png).
+void writeVisRunFolder(const RunContext& context, RunVis& vis, const RunRecord& record);
 
 }  // namespace drover::cli

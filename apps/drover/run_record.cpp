@@ -74,14 +74,14 @@ Json BoundedQuantiles::percentiles() const {
   return Json{{"p50", quantile(0.50)}, {"p95", quantile(0.95)}, {"max", max_}, {"count", count_}};
 }
 
-void SweepLog::streamTo(const std::string& path) {
+void JsonLines::streamTo(const std::string& path) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (f == nullptr) throw io::IoError(path, "", std::string("cannot open for writing: ") + std::strerror(errno));
   file_.reset(f, [](std::FILE* p) { std::fclose(p); });
   path_ = path;
 }
 
-void SweepLog::keepNewest(std::size_t n) { keep_ = n; }
+void JsonLines::keepNewest(std::size_t n) { keep_ = n; }
 
 Json SweepLog::line(const pipeline::ScanOutcome& s) {
   Json j = {{"t", toSeconds(s.t)},
@@ -119,18 +119,20 @@ Json SweepLog::line(const pipeline::ScanOutcome& s) {
   return j;
 }
 
-void SweepLog::add(const pipeline::ScanOutcome& s) {
+void JsonLines::add(const Json& line) {
   ++lines_;
-  const std::string text = line(s).dump() + "\n";
+  if (!file_ && keep_ == 0) return;
+  const std::string text = line.dump() + "\n";
   if (file_) {
-    if (std::fputs(text.c_str(), file_.get()) < 0) throw io::IoError(path_, "sweep " + std::to_string(lines_), "write failed");
-  } else if (keep_ > 0) {
+    if (std::fputs(text.c_str(), file_.get()) < 0)
+      throw io::IoError(path_, record_ + " " + std::to_string(lines_), "write failed");
+  } else {
     newest_.push_back(text);
     if (newest_.size() > keep_) newest_.pop_front();
   }
 }
 
-void SweepLog::finish(const std::string& path) {
+void JsonLines::finish(const std::string& path) {
   if (file_) {
     if (std::fflush(file_.get()) != 0 || std::ferror(file_.get()) != 0)
       throw io::IoError(path_, "", "write failed (disk full?)");

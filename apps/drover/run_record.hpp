@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/trajectory_io.hpp"
@@ -39,26 +40,37 @@ class BoundedQuantiles {
   double sum_ = 0, max_ = 0;
 };
 
-// report.json's per-sweep lines (one JSON object a line: t, status, iterations, fitness_m, inliers, points,
-// features, keyframe, degenerate, min_eigenvalue, imu, reset, total_ms; degenerate_directions on a degenerate sweep,
-// warning on a sweep with one, and with the IMU v_world / gyro_bias / acc_bias).
-class SweepLog {
+// One JSON object a line (JSONL): a run's per-sweep and per-frame records in bounded memory, streamed to the run
+// folder as they come or, live, the newest few kept.
+class JsonLines {
  public:
+  explicit JsonLines(std::string record) : record_(std::move(record)) {}  // "sweep": names the line a failed write was
   // Each line written to `path` as it comes (drover run: OUT.partial/sweeps.jsonl). Throws IoError.
   void streamTo(const std::string& path);
   // Only the newest `n` lines kept in memory (the ROS node, whose save may come at any time).
   void keepNewest(std::size_t n);
-  void add(const pipeline::ScanOutcome& s);
+  void add(const nlohmann::json& line);  // throws IoError on a failed write
   // The streamed file closed (flushed; throws IoError on a failed write), or the kept lines written to `path`.
   void finish(const std::string& path);
   std::size_t lines() const { return lines_; }
-  static nlohmann::json line(const pipeline::ScanOutcome& s);
+  bool streaming() const { return file_ != nullptr; }
 
  private:
+  std::string record_;
   std::shared_ptr<std::FILE> file_;
   std::string path_;
   std::deque<std::string> newest_;
   std::size_t keep_ = 0, lines_ = 0;
+};
+
+// report.json's per-sweep lines (sweeps.jsonl: t, status, iterations, fitness_m, inliers, points, features, keyframe,
+// degenerate, min_eigenvalue, imu, reset, total_ms; degenerate_directions on a degenerate sweep, warning on a sweep
+// with one, and with the IMU v_world / gyro_bias / acc_bias).
+class SweepLog : public JsonLines {
+ public:
+  SweepLog() : JsonLines("sweep") {}
+  void add(const pipeline::ScanOutcome& s) { JsonLines::add(line(s)); }
+  static nlohmann::json line(const pipeline::ScanOutcome& s);
 };
 
 // The IMU-rate odometry streamed to a TUM file as it comes (an hour at 200 Hz would be ~100 MB in memory), in

@@ -27,6 +27,16 @@ void warnEvenWhenQuiet(const std::string& message) {
   spdlog::set_level(level);
 }
 
+// A line of vis_frames.jsonl: what the VIS made of one camera frame.
+Json frameLine(const vio::VisFrame& f) {
+  const vio::FrameResult& r = f.estimate;
+  return {{"t", toSeconds(r.t)},          {"initialized", r.initialized}, {"keyframe", r.keyframe},
+          {"detected", f.detected},       {"tracked", f.front_tracked},  {"features", r.features},
+          {"with_lidar_depth", r.with_lidar_depth}, {"outliers", r.outliers}, {"iterations", r.iterations},
+          {"ms", {{"track", f.ms.track}, {"depth", f.ms.depth}, {"solve", f.ms.solve},
+                  {"marginalize", f.ms.marginalize}, {"total", f.ms.total}}}};
+}
+
 }  // namespace
 
 VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method) {
@@ -152,9 +162,44 @@ void RunVis::record(const vio::VisFrame& f) {
   coasting_ = r.coasting;
   coasted_ += r.coasting ? 1 : 0;
   new_state_ = states_.onFrame(r);
-  if (r.initialized) trajectory_.push_back({r.t, r.T_world_imu});
-  records_.push_back({r.t, r.initialized, r.keyframe, f.detected, f.front_tracked, r.features, r.with_lidar_depth,
-                      r.outliers, r.iterations, f.share_three, f.ms});
+  if (r.initialized) {
+    ++estimated_;
+    if (!trajectory_ && !trajectory_path_.empty())
+      trajectory_ = std::make_unique<ImuRateFile>(trajectory_path_, T_imu_body_);
+    if (trajectory_) trajectory_->add(r.t, r.T_world_imu);
+  }
+  sums_.add(f);
+  if (!frames_.streaming() && !frames_path_.empty()) frames_.streamTo(frames_path_);
+  frames_.add(frameLine(f));
+}
+
+void RunVis::streamTo(const std::string& frames_path, const std::string& trajectory_path,
+                      const Eigen::Isometry3d& T_imu_body) {
+  frames_path_ = frames_path;
+  trajectory_path_ = trajectory_path;
+  T_imu_body_ = T_imu_body;
+}
+
+ImuRateFile::Summary RunVis::finishFiles() {
+  if (frames_.streaming()) frames_.finish(frames_path_);
+  if (!trajectory_) {
+    frames_path_.clear(), trajectory_path_.clear();
+    return {};
+  }
+  const ImuRateFile::Summary s = trajectory_->copyTo(trajectory_path_);  // flushes
+  trajectory_.reset();
+  frames_path_.clear(), trajectory_path_.clear();  // a frame after this is counted, not written
+  return s;
+}
+
+void VisFrameSums::add(const vio::VisFrame& f) {
+  const vio::FrameResult& r = f.estimate;
+  ++frames;
+  keyframes += r.keyframe ? 1 : 0;
+  detected += f.detected ? 1 : 0;
+  tracked += f.front_tracked, with_depth += r.with_lidar_depth, share_three += f.share_three;
+  ms.track += f.ms.track, ms.depth += f.ms.depth, ms.solve += f.ms.solve, ms.marginalize += f.ms.marginalize;
+  ms.covariance += f.ms.covariance, ms.total += f.ms.total;
 }
 
 std::optional<pipeline::VisualState> RunVis::takeState() {
@@ -170,7 +215,7 @@ Json RunVis::report() const {
   j["init_mode"] = vio::toString(vio_config_.init);
   j["frames_in"] = frames_in_;
   j["frames_bad"] = frames_bad_;
-  j["frames_estimated"] = trajectory_.size();
+  j["frames_estimated"] = estimated_;
   j["initialized"] = first_init_.has_value();
   if (first_init_) j["first_init_s"] = toSeconds(*first_init_);
   if (!first_init_) j["not_initialized_because"] = waiting_;
@@ -182,30 +227,17 @@ Json RunVis::report() const {
   Json events = Json::array();
   for (const Event& e : events_) events.push_back({{"t", toSeconds(e.t)}, {"kind", e.kind}, {"what", e.what}});
   j["events"] = events;
-  // Means over the frames, and per frame (compact columns).
-  double track = 0, depth = 0, solve = 0, marg = 0, cov = 0, total = 0, tracked = 0, with_depth = 0, three = 0;
-  std::size_t n = 0, keyframes = 0, detected = 0;
-  Json frames = Json::array();
-  for (const VisFrameRecord& r : records_) {
-    track += r.ms.track, depth += r.ms.depth, solve += r.ms.solve, marg += r.ms.marginalize, total += r.ms.total;
-    cov += r.ms.covariance;
-    tracked += r.tracked, with_depth += r.with_depth, three += r.share_three;
-    keyframes += r.keyframe ? 1 : 0;
-    detected += r.detected ? 1 : 0;
-    ++n;
-    frames.push_back({toSeconds(r.t), r.initialized, r.tracked, r.features, r.with_depth, r.keyframe, r.outliers,
-                      r.ms.total});
-  }
-  const double d = n > 0 ? static_cast<double>(n) : 1.0;
-  j["keyframes"] = keyframes;
-  j["frames_detected"] = detected;
-  j["mean"] = {{"tracked", tracked / d},
-               {"features_with_lidar_depth", with_depth / d},
-               {"share_features_in_3_or_more_frames", three / d}};
-  j["ms_per_frame"] = {{"track", track / d}, {"depth", depth / d}, {"solve", solve / d},
-                       {"marginalize", marg / d}, {"covariance", cov / d}, {"total", total / d}};
-  j["frame_columns"] = {"t", "initialized", "tracked", "features", "with_lidar_depth", "keyframe", "outliers", "ms"};
-  j["frames"] = frames;
+  // Means over the frames; the frames themselves are in vis_frames.jsonl.
+  const VisFrameSums& m = sums_;
+  const double d = m.frames > 0 ? static_cast<double>(m.frames) : 1.0;
+  j["keyframes"] = m.keyframes;
+  j["frames_detected"] = m.detected;
+  j["mean"] = {{"tracked", m.tracked / d},
+               {"features_with_lidar_depth", m.with_depth / d},
+               {"share_features_in_3_or_more_frames", m.share_three / d}};
+  j["ms_per_frame"] = {{"track", m.ms.track / d},         {"depth", m.ms.depth / d},
+                       {"solve", m.ms.solve / d},         {"marginalize", m.ms.marginalize / d},
+                       {"covariance", m.ms.covariance / d}, {"total", m.ms.total / d}};
   return j;
 }
 

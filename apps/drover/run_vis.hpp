@@ -1,7 +1,8 @@
 #pragma once
 // The VIS inside `drover run`: feeds vio::VisualOdometry with the dataset's IMU and camera frames and, when the
-// LIS runs, with its deskewed sweeps (lidar depth) and its states (initialisation); keeps the VIS trajectory and
-// per-frame records for trajectory_vis.tum and report.json's "vis" section.
+// LIS runs, with its deskewed sweeps (lidar depth) and its states (initialisation); streams the VIS trajectory and
+// the per-frame records to trajectory_vis.tum and vis_frames.jsonl as they come (an hour at 15 Hz kept in memory was
+// 15 MB, and report.json's per-frame array 21 MB more at the end), and keeps counts and sums for report.json's "vis".
 #include <nlohmann/json.hpp>
 
 #include <memory>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "apps/drover/run_preset.hpp"
+#include "apps/drover/run_record.hpp"
 #include "apps/drover/track_ahead.hpp"
 #include "io/reader.hpp"
 #include "pipeline/lidar_odometry.hpp"
@@ -18,12 +20,12 @@
 
 namespace drover::cli {
 
-struct VisFrameRecord {
-  Time t = 0;
-  bool initialized = false, keyframe = false, detected = false;
-  int tracked = 0, features = 0, with_depth = 0, outliers = 0, iterations = 0;
-  double share_three = 0;  // of the solved features, seen in >= 3 window frames
+// Sums over the recorded frames, for report.json's means.
+struct VisFrameSums {
+  std::size_t frames = 0, keyframes = 0, detected = 0;
+  double tracked = 0, with_depth = 0, share_three = 0;
   vio::VisStageMs ms;
+  void add(const vio::VisFrame& f);
 };
 
 // The VIS's configuration and detector from a platform config.
@@ -48,6 +50,13 @@ class RunVis {
   explicit RunVis(const VisSetup& setup);
   ~RunVis();
   void record(const vio::VisFrame& frame);
+  // Where the per-frame lines and the trajectory (T_world_imu * T_imu_body, trajectory.tum's body frame) go; each
+  // file is opened at its first line, so a run without camera frames writes neither. Without this call the lines
+  // and poses are counted, not kept. Throws IoError on a failed write.
+  void streamTo(const std::string& frames_path, const std::string& trajectory_path,
+                const Eigen::Isometry3d& T_imu_body);
+  // Both files flushed and closed; the trajectory's count and span (no poses: no file).
+  ImuRateFile::Summary finishFiles();
   void attach(const vio::VisualOdometry* vo, std::size_t frames_in, std::size_t frames_bad);
 
   void onImu(const ImuSample& sample);
@@ -64,9 +73,9 @@ class RunVis {
   // nothing when that frame had no estimate or it was taken.
   std::optional<pipeline::VisualState> takeState();
 
-  const Trajectory& trajectory() const { return trajectory_; }  // T_world_imu at every initialised frame
+  std::size_t framesEstimated() const { return estimated_; }  // frames with a pose (initialised)
   const std::string& detectorName() const { return detector_name_; }
-  // report.json's "vis" section (without the APE, which the caller adds).
+  // report.json's "vis" section (without the APE, which the caller adds): counts, events, means.
   nlohmann::json report() const;
   std::size_t framesIn() const { return frames_in_; }
   const std::string& waitingReason() const { return waiting_; }  // why the VIS has not initialised (the newest)
@@ -79,8 +88,13 @@ class RunVis {
   const vio::VisualOdometry* vo_ = nullptr;  // own_, or the System's
   std::string detector_name_;
   vio::VioConfig vio_config_;
-  Trajectory trajectory_;
-  std::vector<VisFrameRecord> records_;
+  std::string trajectory_path_;
+  Eigen::Isometry3d T_imu_body_ = Eigen::Isometry3d::Identity();
+  std::unique_ptr<ImuRateFile> trajectory_;  // opened at the first pose
+  std::size_t estimated_ = 0;
+  std::string frames_path_;
+  JsonLines frames_{"camera frame"};  // opened at the first frame
+  VisFrameSums sums_;
   struct Event {
     Time t;
     std::string kind, what;
