@@ -9,7 +9,9 @@
 #   ABLATION_COURSES="corridor farm" ABLATION_ROWS="lis lvi-sam drover" bash bench/eval_ablation.sh
 #   ABLATION_LOOPS=0: without loop closure (the default runs with it).
 #   ABLATION_DROVER_EXTRA="--without superpoint": appended to the vis row and every drover row (Shi-Tomasi rows:
-#   the farm course takes ~6.5 min a row instead of ~9.5). The row drover+superpoint is the whole preset regardless.
+#   the farm course takes ~6.5 min a row instead of ~9.5). The row drover+superpoint is the whole preset regardless,
+#   drover+superpoint-PART the whole preset without PART (drover+superpoint-lk-min-eigenvalue: SuperPoint's tracks at
+#   the platform's LK threshold).
 # Courses are generated once into $DROVER_OUT/sim/<course>-cam (farm-N: seed N; kitti05-replay needs ../shared/data
 # and ~14 GB with its camera). Runs are kept in $DROVER_OUT/ablation/<course>/<row>.
 set -euo pipefail
@@ -31,6 +33,7 @@ row_flags() {  # the drover run options of a row
     lvi-sam) echo "--preset lvi-sam" ;;
     drover) echo "--preset drover ${EXTRA[*]}" ;;
     drover+superpoint) echo "--preset drover" ;;  # the whole preset, whatever ABLATION_DROVER_EXTRA says
+    drover+superpoint-*) echo "--preset drover --without ${1#drover+superpoint-}" ;;  # the whole preset without a part
     drover-*) echo "--preset drover --without ${1#drover-} ${EXTRA[*]}" ;;
     *) echo "unknown row $1" >&2; exit 2 ;;
   esac

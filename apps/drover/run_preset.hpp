@@ -9,7 +9,8 @@
 //            Drover's health gates, no reset of the VIS by the LIS), a degenerate match's pose the match's own (its
 //            degenerate directions at the guess, as LIO-SAM's mapOptimization), loop closure by the nearest old keyframe within
 //            15 m and 30 s verified by ICP (no Scan Context). Its visual DBoW2 loop detector is not reproduced.
-//   drover:  SuperPoint + KLT, lidar depth as factors, the VIS's motion as guess and factor behind the health gates
+//   drover:  SuperPoint + KLT (SuperPoint's tracks held to a smallest gradient eigenvalue of 2e-3: none sliding
+//            along an edge), lidar depth as factors, the VIS's motion as guess and factor behind the health gates
 //            with resets by the LIS, Scan Context with the VIS's yaw prior.
 #include <string>
 #include <vector>
@@ -31,7 +32,8 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio);
 // drover run --without PART (the ablation's rows: the system without one of its parts, after the preset):
 //   vo-factor (the VIS's motion as a factor), vis-guess (... as the matcher's guess), vis-gates (the health gates
 //   and the reset by the LIS), visual-yaw-prior (loop closure's VIS yaw), scan-context (radius loops instead),
-//   depth-factor (lidar depth held fixed instead), superpoint (Shi-Tomasi instead).
+//   depth-factor (lidar depth held fixed instead), superpoint (Shi-Tomasi instead), lk-min-eigenvalue (SuperPoint's
+//   tracks at the platform's LK threshold).
 std::vector<std::string> partNames();
 
 // A run's choice: the preset, then the parts taken out.

@@ -73,9 +73,13 @@ RunVis::RunVis(const VisSetup& setup, const Calibration& calibration, const imu:
     : own_(std::make_unique<vio::VisualOdometry>(setup.config, calibration, imu, setup.detector)),
       vo_(own_.get()),
       detector_name_(setup.detector_name),
-      vio_config_(setup.config.vio) {}
+      vio_config_(setup.config.vio),
+      lk_min_eigenvalue_(setup.config.tracker.min_eigenvalue) {}
 
-RunVis::RunVis(const VisSetup& setup) : detector_name_(setup.detector_name), vio_config_(setup.config.vio) {}
+RunVis::RunVis(const VisSetup& setup)
+    : detector_name_(setup.detector_name),
+      vio_config_(setup.config.vio),
+      lk_min_eigenvalue_(setup.config.tracker.min_eigenvalue) {}
 
 void RunVis::attach(const vio::VisualOdometry* vo, std::size_t frames_in, std::size_t frames_bad) {
   vo_ = vo;
@@ -211,6 +215,7 @@ std::optional<pipeline::VisualState> RunVis::takeState() {
 Json RunVis::report() const {
   Json j;
   j["detector"] = detector_name_;
+  j["lk_min_eigenvalue"] = lk_min_eigenvalue_;
   j["depth_mode"] = vio::toString(vio_config_.depth_mode);
   j["init_mode"] = vio::toString(vio_config_.init);
   j["frames_in"] = frames_in_;

@@ -88,6 +88,7 @@ class RunVis {
   const vio::VisualOdometry* vo_ = nullptr;  // own_, or the System's
   std::string detector_name_;
   vio::VioConfig vio_config_;
+  double lk_min_eigenvalue_ = 0;  // the tracker's, after the preset
   std::string trajectory_path_;
   Eigen::Isometry3d T_imu_body_ = Eigen::Isometry3d::Identity();
   std::unique_ptr<ImuRateFile> trajectory_;  // opened at the first pose

@@ -41,7 +41,8 @@ struct FeatureTrackerConfig {
   // on a textureless wall, and a VIS re-initialised on their sliding tracks tilted itself 0.8 deg (bench/RESULTS.md).
   // The scale is the camera's: measured over tracked features, the simulated camera's textured surfaces
   // 5.5e-3 / 9e-3 (p10 / p50), its textureless ones 3e-4 / 4.5e-4; EuRoC's real frames 1.5e-3 / 1.3e-2. So it is a
-  // platform setting; every shipped platform file keeps OpenCV's default for now (2e-3 on the farm: bench/RESULTS.md).
+  // platform setting; the shipped platform files keep OpenCV's default, and drover run's drover preset raises it to
+  // 2e-3 for SuperPoint's tracks (apps/drover/run_preset.cpp; bench/RESULTS.md).
   double min_eigenvalue = 1e-4;
   bool forward_backward = true;     // track back and drop points that do not return
   double forward_backward_px = 0.5;  // [px] largest forward-backward distance kept

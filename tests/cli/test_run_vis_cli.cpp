@@ -141,6 +141,7 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_EQ(r["loops"]["sigma_fitness_reference_m"], 0.0);
   EXPECT_EQ(r["vis"]["depth_mode"], "fixed");
   EXPECT_EQ(r["vis"]["detector"], "shi-tomasi");
+  EXPECT_EQ(r["vis"]["lk_min_eigenvalue"], 1e-4) << "OpenCV's default, as LVI-SAM's tracker";
   EXPECT_EQ(r["counts"]["vis_factor_scans"], 0) << "LVI-SAM's released code has no visual odometry factor";
   EXPECT_GT(r["counts"]["vis_guess_scans"].get<int>(), 20);
   const CliResult nf = runDrover(base + " -q --no-loop --preset drover --without superpoint --without vo-factor "
@@ -149,6 +150,7 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   const Json n = readJson(dir / "nf" / "report.json");
   EXPECT_EQ(n["preset"], "drover without superpoint, vo-factor");
   EXPECT_EQ(n["vis"]["depth_mode"], "factor");
+  EXPECT_EQ(n["vis"]["lk_min_eigenvalue"], 1e-4) << "Shi-Tomasi's tracks keep the platform's LK threshold";
   EXPECT_EQ(n["counts"]["vis_factor_scans"], 0);
   EXPECT_EQ(n["loops"]["graph_dof"], 4) << "the drover preset's pose graph leaves roll and pitch to the IMU";
   const CliResult bad = runDrover(base + " --preset vins --out " + (dir / "bad").string());
