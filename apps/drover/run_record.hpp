@@ -44,7 +44,8 @@ class BoundedQuantiles {
 // folder as they come or, live, the newest few kept.
 class JsonLines {
  public:
-  explicit JsonLines(std::string record) : record_(std::move(record)) {}  // "sweep": names the line a failed write was
+  // record: what a line is ("sweep"), for the error of a failed write.
+  explicit JsonLines(std::string record) : record_(std::move(record)) {}
   // Each line written to `path` as it comes (drover run: OUT.partial/sweeps.jsonl). Throws IoError.
   void streamTo(const std::string& path);
   // Only the newest `n` lines kept in memory (the ROS node, whose save may come at any time).

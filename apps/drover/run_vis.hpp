@@ -15,7 +15,6 @@
 #include "apps/drover/track_ahead.hpp"
 #include "io/reader.hpp"
 #include "pipeline/lidar_odometry.hpp"
-#include "types/trajectory.hpp"
 #include "vio/visual_odometry.hpp"
 
 namespace drover::cli {
