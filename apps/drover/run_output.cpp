@@ -172,15 +172,13 @@ double pathLength(const Trajectory& poses) {  // [m]
   return length;
 }
 
-// The VIS's streamed files finished into the folder; returns report.json's "vis" section with the VIS's own
-// translation APE (SE(3)-aligned, the trajectory read back) when there is ground truth, printed as evo does.
-Json finishVisFiles(const RunContext& c, RunVis& vis) {
+// report.json's "vis" section: the VIS's counts and means and, with ground truth, its own translation APE
+// (SE(3)-aligned) of `est`, trajectory_vis.tum as written, printed as evo does.
+Json visSection(const RunContext& c, const RunVis& vis, const Trajectory& est) {
   Json j = vis.report();
-  const ImuRateFile::Summary s = vis.finishFiles();
-  if (s.poses < 3 || c.ground_truth.poses.empty()) return j;
+  if (est.size() < 3 || c.ground_truth.poses.empty()) return j;
   try {
-    const eval::ApeResult a =
-        eval::computeApe(c.ground_truth.poses, io::readTum(inRun(c, "trajectory_vis.tum")), se3ApeOptions());
+    const eval::ApeResult a = eval::computeApe(c.ground_truth.poses, est, se3ApeOptions());
     if (spdlog::should_log(spdlog::level::info)) fmt::print("VIS {}\n\n{}\n", apeTitle(a), statisticsTable(a.stats));
     j["ape"] = statisticsJson(a.stats);
     const double length = pathLength(c.ground_truth.poses);
@@ -189,6 +187,13 @@ Json finishVisFiles(const RunContext& c, RunVis& vis) {
     j["ape"] = {{"error", e.what()}};
   }
   return j;
+}
+
+// Beside the LIS: the VIS's streamed files finished into the folder, its trajectory read back only to be evaluated.
+Json finishVisFiles(const RunContext& c, RunVis& vis) {
+  const ImuRateFile::Summary s = vis.finishFiles();
+  const bool evaluated = s.poses >= 3 && !c.ground_truth.poses.empty();
+  return visSection(c, vis, evaluated ? io::readTum(inRun(c, "trajectory_vis.tum")) : Trajectory{});
 }
 
 }  // namespace
@@ -203,17 +208,18 @@ void writeVisRunFolder(const RunContext& c, RunVis& vis, const RunRecord& r) {
   report["end"] = {{"reason", r.end}, {"interrupted", r.end.rfind("interrupted", 0) == 0}};
   report["body_frame"] = c.ground_truth.body_frame.empty() ? "imu" : c.ground_truth.body_frame;
   report["wall_s"] = r.wall_s;
-  report["vis"] = finishVisFiles(c, vis);  // trajectory_vis.tum complete from here
+  vis.finishFiles();  // trajectory_vis.tum complete from here
   const std::string vis_path = inRun(c, "trajectory_vis.tum"), path = inRun(c, "trajectory.tum");
   std::error_code e;  // trajectory.tum is the VIS's here, byte for byte
   fs::copy_file(vis_path, path, fs::copy_options::overwrite_existing, e);
   if (e) throw io::IoError(path, "", "cannot copy the VIS trajectory from " + vis_path + ": " + e.message());
-  const Trajectory est = io::readTum(path);
+  const Trajectory est = io::readTum(path);  // read once, for both APEs
   const double data_s = est.size() > 1 ? toSeconds(est.back().t - est.front().t) : 0.0;
   report["data_s"] = data_s;
   report["real_time_factor"] = r.wall_s > 0 ? data_s / r.wall_s : 0.0;
   report["counts"] = {{"measurements_dropped", r.measurements_dropped}};
   report["ape"] = evaluate(c, est);
+  report["vis"] = visSection(c, vis, est);
   io::writeFileAtomically(inRun(c, "report.json"), report.dump(2) + "\n");
   spdlog::info("VIS: {} of {} camera frames estimated, {} resets, in {:.1f} s: {:.1f}x real time; results in {}",
                est.size(), vis.framesIn(), report["vis"]["resets"].get<std::size_t>(), r.wall_s,

@@ -34,6 +34,16 @@ void withoutGates(pipeline::VisualMotionConfig& f) {
   f.min_features = 1;
 }
 
+// The drover preset's LK threshold for SuperPoint's tracks [smallest eigenvalue of the window's gradient matrix per
+// pixel, intensities in [0, 1]]. Shi-Tomasi picks its corners by that eigenvalue (at least 1 % of the frame's
+// strongest corner: ~1e-3 on textured frames), SuperPoint by a learnt score that also fires on edges and on plain
+// walls at a low confidence; LK slides along such an edge. 2e-3 keeps textured tracks (the simulated camera's p10
+// 5.5e-3) and drops the plain walls' (p90 4e-3 in the textureless stretch). On the simulated farm, the whole preset:
+// seeds 1 / 2 / 3 0.168 / 0.210 / 0.191 -> 0.130 / 0.123 / 0.190 m, and the VIS re-initialised after a textureless
+// stretch no longer tilts itself (bench/RESULTS.md). Shi-Tomasi's tracks keep the platform's value: at 2e-3 the farm
+// with Shi-Tomasi went 0.167 -> 0.182 m.
+constexpr double kSuperPointMinEigenvalue = 2e-3;
+
 }  // namespace
 
 void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
@@ -96,20 +106,6 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
     visual.tracker.min_eigenvalue = visual::FeatureTrackerConfig{}.min_eigenvalue;
   }
 }
-
-namespace {
-
-// The drover preset's LK threshold for SuperPoint's tracks [smallest eigenvalue of the window's gradient matrix per
-// pixel, intensities in [0, 1]]. Shi-Tomasi picks its corners by that eigenvalue (at least 1 % of the frame's
-// strongest corner: ~1e-3 on textured frames), SuperPoint by a learnt score that also fires on edges and on plain
-// walls at a low confidence; LK slides along such an edge. 2e-3 keeps textured tracks (the simulated camera's p10
-// 5.5e-3) and drops the plain walls' (p90 4e-3 in the textureless stretch). On the simulated farm, the whole preset:
-// seeds 1 / 2 / 3 0.168 / 0.210 / 0.191 -> 0.130 / 0.123 / 0.190 m, and the VIS re-initialised after a textureless
-// stretch no longer tilts itself (bench/RESULTS.md). Shi-Tomasi's tracks keep the platform's value: at 2e-3 the farm
-// with Shi-Tomasi went 0.167 -> 0.182 m.
-constexpr double kSuperPointMinEigenvalue = 2e-3;
-
-}  // namespace
 
 std::vector<std::string> partNames() {
   return {"vo-factor",     "vis-guess", "vis-gates",          "visual-yaw-prior", "scan-context",

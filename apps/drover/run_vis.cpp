@@ -186,11 +186,8 @@ void RunVis::streamTo(const std::string& frames_path, const std::string& traject
 
 ImuRateFile::Summary RunVis::finishFiles() {
   if (frames_.streaming()) frames_.finish(frames_path_);
-  if (!trajectory_) {
-    frames_path_.clear(), trajectory_path_.clear();
-    return {};
-  }
-  const ImuRateFile::Summary s = trajectory_->copyTo(trajectory_path_);  // flushes
+  ImuRateFile::Summary s;
+  if (trajectory_) s = trajectory_->copyTo(trajectory_path_);  // flushes
   trajectory_.reset();
   frames_path_.clear(), trajectory_path_.clear();  // a frame after this is counted, not written
   return s;
