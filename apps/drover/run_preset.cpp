@@ -34,14 +34,16 @@ void withoutGates(pipeline::VisualMotionConfig& f) {
   f.min_features = 1;
 }
 
-// The drover preset's LK threshold for SuperPoint's tracks [smallest eigenvalue of the window's gradient matrix per
-// pixel, intensities in [0, 1]]. Shi-Tomasi picks its corners by that eigenvalue (at least 1 % of the frame's
-// strongest corner: ~1e-3 on textured frames), SuperPoint by a learnt score that also fires on edges and on plain
-// walls at a low confidence; LK slides along such an edge. 2e-3 keeps textured tracks (the simulated camera's p10
-// 5.5e-3) and drops the plain walls' (p90 4e-3 in the textureless stretch). On the simulated farm, the whole preset:
-// seeds 1 / 2 / 3 0.168 / 0.210 / 0.191 -> 0.130 / 0.123 / 0.190 m, and the VIS re-initialised after a textureless
-// stretch no longer tilts itself (bench/RESULTS.md). Shi-Tomasi's tracks keep the platform's value: at 2e-3 the farm
-// with Shi-Tomasi went 0.167 -> 0.182 m.
+// The drover preset's LK threshold for SuperPoint's tracks (visual::FeatureTrackerConfig::min_eigenvalue: OpenCV's
+// units, g^2 / 1024 for an RMS gradient of g grey levels a pixel in the window's weakest direction). Shi-Tomasi picks
+// its corners by that eigenvalue (at least 1 % of the frame's strongest corner: ~1e-3 on textured frames), SuperPoint
+// by a learnt score that at a low confidence also fires on plain walls and their edges. 2e-3 is ~2x the eigenvalue
+// that the simulated camera's shot noise alone gives at mid-grey (~2 grey levels: ~9e-4): it keeps textured tracks
+// (its p10 5.5e-3) and drops the plain walls' (in the textureless stretch 75 % of the tracks see only noise and
+// fall below it; the walls' edges there are strong enough to stay). On the simulated farm, the whole preset: seeds
+// 1 / 2 / 3 0.168 / 0.210 / 0.191 -> 0.130 / 0.123 / 0.190 m, and the VIS re-initialised after a textureless stretch
+// no longer tilts itself (bench/RESULTS.md).
+// Shi-Tomasi's tracks keep the platform's value: at 2e-3 the farm with Shi-Tomasi went 0.167 -> 0.182 m.
 constexpr double kSuperPointMinEigenvalue = 2e-3;
 
 }  // namespace

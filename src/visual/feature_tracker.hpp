@@ -36,13 +36,16 @@ struct FeatureTrackerConfig {
   int flow_iterations = 30;         // LK iterations per level
   double flow_epsilon = 0.01;       // [px] LK convergence
   // cv::calcOpticalFlowPyrLK's minEigThreshold: a track is lost where the smallest eigenvalue of its window's
-  // gradient matrix (per pixel, intensities in [0, 1]) falls below this. On a plain surface the window sees only
-  // noise or an edge, along which LK slides (the aperture problem): SuperPoint at a low confidence keeps such points
-  // on a textureless wall, and a VIS re-initialised on their sliding tracks tilted itself 0.8 deg (bench/RESULTS.md).
-  // The scale is the camera's: measured over tracked features, the simulated camera's textured surfaces
-  // 5.5e-3 / 9e-3 (p10 / p50), its textureless ones 3e-4 / 4.5e-4; EuRoC's real frames 1.5e-3 / 1.3e-2. So it is a
-  // platform setting; the shipped platform files keep OpenCV's default, and drover run's drover preset raises it to
-  // 2e-3 for SuperPoint's tracks (apps/drover/run_preset.cpp; bench/RESULTS.md).
+  // gradient matrix falls below this. OpenCV's units: per pixel of the window, from Scharr derivatives scaled by 2^-20,
+  // so a window whose weakest direction has an RMS gradient of g grey levels a pixel gives g^2 / 1024, and image noise
+  // of sigma grey levels alone about 2.3e-4 sigma^2 (Scharr's noise gain 236 sigma^2 / 2^20). Two kinds of track fall
+  // below it: windows that see only noise (a plain wall; LK follows the noise) and windows on one straight edge,
+  // along which LK slides (the aperture problem). Measured over the tracked features of the simulated camera
+  // (p10 / p50): textured surfaces 5.5e-3 / 9e-3, textureless ones 3e-4 / 4.5e-4 (noise: its shot noise of ~2 grey
+  // levels at mid-grey gives ~9e-4); EuRoC's real frames 1.5e-3 / 1.3e-2. So it is a noise floor in grey levels,
+  // and a platform setting: the shipped platform files keep OpenCV's default, and drover run's drover preset raises
+  // it to 2e-3 for SuperPoint's tracks (apps/drover/run_preset.cpp; bench/RESULTS.md). A camera at high gain, or
+  // with CLAHE on its dark frames, has more noise in grey levels and needs a higher floor (it goes with sigma^2).
   double min_eigenvalue = 1e-4;
   bool forward_backward = true;     // track back and drop points that do not return
   double forward_backward_px = 0.5;  // [px] largest forward-backward distance kept
