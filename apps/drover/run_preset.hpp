@@ -10,8 +10,8 @@
 //            degenerate directions at the guess, as LIO-SAM's mapOptimization), loop closure by the nearest old keyframe within
 //            15 m and 30 s verified by ICP (no Scan Context). Its visual DBoW2 loop detector is not reproduced.
 //   drover:  SuperPoint + KLT (SuperPoint's tracks held to a smallest gradient eigenvalue of 2e-3: none following a
-//            plain wall's image noise or sliding along an edge), lidar depth as factors, the VIS's motion as guess and factor behind the health gates
-//            with resets by the LIS, Scan Context with the VIS's yaw prior.
+//            plain wall's image noise or sliding along an edge), lidar depth as factors, the VIS's motion as guess
+//            and factor behind the health gates with resets by the LIS, Scan Context with the VIS's yaw prior.
 #include <string>
 #include <vector>
 
