@@ -32,7 +32,7 @@ Json frameLine(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
   return {{"t", toSeconds(r.t)},          {"initialized", r.initialized}, {"keyframe", r.keyframe},
           {"detected", f.detected},       {"tracked", f.front_tracked},  {"features", r.features},
-          {"with_lidar_depth", r.with_lidar_depth}, {"outliers", r.outliers}, {"iterations", r.iterations},
+          {"with_lidar_depth", r.with_lidar_depth}, {"on_ground", r.on_ground}, {"outliers", r.outliers}, {"iterations", r.iterations},
           {"ms", {{"track", f.ms.track}, {"depth", f.ms.depth}, {"solve", f.ms.solve},
                   {"marginalize", f.ms.marginalize}, {"total", f.ms.total}}}};
 }
@@ -199,6 +199,7 @@ void VisFrameSums::add(const vio::VisFrame& f) {
   keyframes += r.keyframe ? 1 : 0;
   detected += f.detected ? 1 : 0;
   tracked += f.front_tracked, with_depth += r.with_lidar_depth, share_three += f.share_three;
+  on_ground += r.on_ground;
   ms.track += f.ms.track, ms.depth += f.ms.depth, ms.solve += f.ms.solve, ms.marginalize += f.ms.marginalize;
   ms.covariance += f.ms.covariance, ms.total += f.ms.total;
 }
@@ -236,6 +237,7 @@ Json RunVis::report() const {
   j["frames_detected"] = m.detected;
   j["mean"] = {{"tracked", m.tracked / d},
                {"features_with_lidar_depth", m.with_depth / d},
+               {"features_on_ground", m.on_ground / d},
                {"share_features_in_3_or_more_frames", m.share_three / d}};
   j["ms_per_frame"] = {{"track", m.ms.track / d},         {"depth", m.ms.depth / d},
                        {"solve", m.ms.solve / d},         {"marginalize", m.ms.marginalize / d},

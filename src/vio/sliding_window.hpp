@@ -59,6 +59,7 @@ struct FrameResult {
   int tracked = 0;                  // features of this frame already in the window
   int features = 0;                 // features used in the solve
   int with_lidar_depth = 0;         // of those, anchored on a lidar depth
+  int on_ground = 0;                // of those, held to the ground below the robot (vio ground_height_m)
   int outliers = 0;                 // observations dropped after the solve
   int iterations = 0;
   double ms_solve = 0, ms_marginalize = 0, ms_covariance = 0;  // [ms]
@@ -110,6 +111,7 @@ class SlidingWindowEstimator {
   std::vector<Eigen::Isometry3d> cameraPoses() const;
   void optimize(FrameResult& result);
   void buildResiduals(Residuals& r, bool for_marginalization_of_oldest) const;
+  void addGroundFactor(Residuals& r, Feature& f) const;
   void removeOutliers(FrameResult& result);
   // Why the window failed (empty: it did not). Too few tracked features are one reason unless result.coasting.
   std::string failure(const FrameResult& result) const;

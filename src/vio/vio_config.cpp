@@ -42,6 +42,11 @@ std::string VioConfig::validate() const {
   if (!(seed_max_median_px >= 0)) return "seed_max_median_px must be >= 0 (0: no check)";
   if (seed_min_observations < 1) return "seed_min_observations must be >= 1";
   if (!positive(sigma_px)) return "sigma_px must be > 0";
+  if (!nonNegative(ground_height_m)) return "ground_height_m must be >= 0 (0: off)";
+  if (!positive(ground_sigma_m) || !nonNegative(ground_slope_sigma_rad))
+    return "ground_sigma_m must be > 0 and ground_slope_sigma_rad >= 0";
+  if (!positive(ground_gate_rel) || !(ground_gate_rel < 1) || !positive(ground_max_range_m))
+    return "ground_gate_rel must be in (0, 1) and ground_max_range_m > 0";
   if (!positive(robust_px)) return "robust_px must be > 0";
   if (!positive(outlier_px)) return "outlier_px must be > 0";
   if (min_observations < 2) return "min_observations must be >= 2";

@@ -88,6 +88,17 @@ struct VioConfig {
   double scale_check_min_change = 0.02;
   double scale_check_max_change = 2.0;
   double scale_check_bias_sigma = 0.01;  // [m/s^2] the accelerometer bias error the check does not estimate
+  // A ground robot's height as the scale a constant-speed drive does not give the IMU (backend/ground_factor.hpp):
+  // a feature without lidar depth whose point, as last solved, lies within ground_gate_rel times the camera's height
+  // above the surface below the anchor frame's body (the height error a scale error of that fraction makes) and
+  // within ground_max_range_m of it (horizontally) is held to that surface with sigma
+  // sqrt(ground_sigma_m^2 + (ground_slope_sigma_rad * range)^2) under a Cauchy loss at one sigma. 0 height: off
+  // (a hand-held rig or a drone has no such surface).
+  double ground_height_m = 0;            // [m] IMU origin above the surface driven on, along the body z axis
+  double ground_sigma_m = 0.03;          // [m] the surface's roughness and the body's bounce on it
+  double ground_slope_sigma_rad = 0.02;  // [rad] the surface's slope under a feature relative to the body's plane
+  double ground_gate_rel = 0.2;          // [1] of the camera's height above the surface
+  double ground_max_range_m = 8;         // [m]
   // Failure detection (VINS-Mono failureDetection).
   int min_tracked = 8;             // fewer features tracked into the newest frame: failure (with a LIS to seed it
                                    // again; alone, after coast_max_s)

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <set>
 
+#include "backend/ground_factor.hpp"
 #include "backend/imu_factors.hpp"
 #include "backend/quaternion_manifold.hpp"
 #include "backend/schur_marginalizer.hpp"
@@ -115,7 +116,10 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
       if (!(cost->cheirality(blocks.data()) > kMinDepth)) continue;
       r.items.push_back({std::move(cost), r.robust.get(), std::move(blocks)});
     }
-    if (!f->lidar_anchor) continue;
+    if (!f->lidar_anchor) {
+      addGroundFactor(r, *f);
+      continue;
+    }
     ++r.with_lidar_depth;
     if (config_.depth_mode == DepthMode::kFixed) {
       r.fixed_depths.insert(&f->inverse_depth);
@@ -129,6 +133,27 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
                          {&f->inverse_depth}});
     }
   }
+}
+
+// A feature whose point, as last solved, lies on the surface below its anchor frame's body is held there
+// (vio_config.hpp ground_*): the point in the anchor IMU frame is R_ic n depth + p_ic. The gate is relative to the
+// camera's height above the surface, h + p_ic.z: a window whose scale is off by a fraction s puts the ground's
+// points s times that height off it.
+void SlidingWindowEstimator::addGroundFactor(Residuals& r, Feature& f) const {
+  const double h = config_.ground_height_m;
+  if (!(h > 0) || !(f.depth > 0)) return;
+  const Observation& oi = f.obs.front();
+  const Eigen::Quaterniond q_ic(q_ic_[3], q_ic_[0], q_ic_[1], q_ic_[2]);
+  const Eigen::Vector3d p_ic(p_ic_[0], p_ic_[1], p_ic_[2]);
+  const Eigen::Vector3d P_b = q_ic * (f.depth * oi.normalized.homogeneous()) + p_ic;
+  const double range = P_b.head<2>().norm();
+  const double gate = config_.ground_gate_rel * std::max(h + p_ic.z(), 0.0);
+  if (std::abs(P_b.z() + h) > gate || range > config_.ground_max_range_m) return;
+  const double sigma = std::hypot(config_.ground_sigma_m, config_.ground_slope_sigma_rad * range);
+  if (!r.ground_robust) r.ground_robust = std::make_unique<ceres::CauchyLoss>(1.0);
+  r.items.push_back({std::make_unique<backend::GroundHeightFactor>(oi.normalized, h, sigma), r.ground_robust.get(),
+                     {const_cast<double*>(p_ic_), const_cast<double*>(q_ic_), &f.inverse_depth}});
+  ++r.on_ground;
 }
 
 void SlidingWindowEstimator::optimize(FrameResult& result) {
@@ -187,6 +212,7 @@ void SlidingWindowEstimator::optimize(FrameResult& result) {
   solver_failed_ = summary.termination_type == ceres::FAILURE || !std::isfinite(summary.final_cost);
   result.features = r.features;
   result.with_lidar_depth = r.with_lidar_depth;
+  result.on_ground = r.on_ground;
 
   const std::set<const double*> solved(r.inverse_depths.begin(), r.inverse_depths.end());
   for (auto& [id, f] : features_.features())
