@@ -162,8 +162,10 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
     }
   }
   lis_bias_.reset();
-  if (seed && config_.lis_bias_prior_sigma_acc > 0)
-    if (const std::optional<SeedState> s = seed(frames_.back()->t)) lis_bias_ = s->bias;
+  const std::optional<SeedState> lis = seed ? seed(frames_.back()->t) : std::nullopt;
+  if (lis && config_.lis_bias_prior_sigma_acc > 0) lis_bias_ = lis->bias;
+  // The ground holds the scale only while no LIS does (vio_config.hpp ground_height_m).
+  ground_active_ = config_.ground_height_m > 0 && !lis;
   optimize(result);
   removeOutliers(result);
   checkCoasting(result, static_cast<bool>(seed));

@@ -141,7 +141,7 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
 // points s times that height off it.
 void SlidingWindowEstimator::addGroundFactor(Residuals& r, Feature& f) const {
   const double h = config_.ground_height_m;
-  if (!(h > 0) || !(f.depth > 0)) return;
+  if (!ground_active_ || !(f.depth > 0)) return;
   const Observation& oi = f.obs.front();
   const Eigen::Quaterniond q_ic(q_ic_[3], q_ic_[0], q_ic_[1], q_ic_[2]);
   const Eigen::Vector3d p_ic(p_ic_[0], p_ic_[1], p_ic_[2]);

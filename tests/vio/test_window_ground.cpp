@@ -86,8 +86,9 @@ struct DriveEnd {
   int resets = 0;
 };
 
-// Seeded once from the truth (as the LIS would), then the window alone for `seconds`.
-DriveEnd drive(unsigned seed, double ground_height, double seconds, bool floor = true) {
+// Seeded from the truth (as the LIS would), then the window alone for `seconds` (or beside the "LIS": `lis`).
+// lis: the seeder keeps returning the true state after the start, as a running LIS does.
+DriveEnd drive(unsigned seed, double ground_height, double seconds, bool floor = true, bool lis = false) {
   StraightDrive scene(seed, floor);
   VioConfig c;
   c.estimate_time_offset = false;
@@ -96,7 +97,7 @@ DriveEnd drive(unsigned seed, double ground_height, double seconds, bool floor =
   SlidingWindowEstimator est(c, imu::PreintegrationConfig{}, scene.T_imu_cam, StraightDrive::kFocal);
   bool initialised = false;
   const Seeder seeder = [&](Time t) -> std::optional<SeedState> {
-    if (initialised) return std::nullopt;
+    if (initialised && !lis) return std::nullopt;
     SeedState s;
     s.T_world_imu = scene.pose(toSeconds(t));
     s.v_world = Eigen::Vector3d(StraightDrive::kSpeed, 0, 0);
@@ -138,6 +139,14 @@ TEST(WindowGround, WithTheGroundHeightAConstantSpeedDriveKeepsItsScale) {
 
 TEST(WindowGround, FeaturesOffTheGroundAreNotHeldToIt) {
   const DriveEnd end = drive(1, StraightDrive::kHeight, 5.0, false);  // walls only: points 0.3-3 m above the floor
+  EXPECT_EQ(end.resets, 0);
+  EXPECT_EQ(end.max_on_ground, 0);
+}
+
+TEST(WindowGround, BesideARunningLisTheGroundIsNotUsed) {
+  // The lidar gives the scale there; on the farm course the ground factors beside the LIS cost the lvi-sam preset
+  // 0.35 -> 2.35 m of APE.
+  const DriveEnd end = drive(1, StraightDrive::kHeight, 4.0, true, true);
   EXPECT_EQ(end.resets, 0);
   EXPECT_EQ(end.max_on_ground, 0);
 }
