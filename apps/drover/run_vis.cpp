@@ -32,7 +32,8 @@ Json frameLine(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
   return {{"t", toSeconds(r.t)},          {"initialized", r.initialized}, {"keyframe", r.keyframe},
           {"detected", f.detected},       {"tracked", f.front_tracked},  {"features", r.features},
-          {"with_lidar_depth", r.with_lidar_depth}, {"on_ground", r.on_ground}, {"outliers", r.outliers}, {"iterations", r.iterations},
+          {"with_lidar_depth", r.with_lidar_depth}, {"on_ground", r.on_ground},
+          {"outliers", r.outliers},       {"iterations", r.iterations},
           {"ms", {{"track", f.ms.track}, {"depth", f.ms.depth}, {"solve", f.ms.solve},
                   {"marginalize", f.ms.marginalize}, {"total", f.ms.total}}}};
 }

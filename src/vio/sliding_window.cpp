@@ -162,7 +162,9 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
     }
   }
   lis_bias_.reset();
-  const std::optional<SeedState> lis = seed ? seed(frames_.back()->t) : std::nullopt;
+  // The LIS's state is looked up only when a prior or the ground needs it, as before the ground existed.
+  const bool need_lis = config_.lis_bias_prior_sigma_acc > 0 || config_.ground_height_m > 0;
+  const std::optional<SeedState> lis = seed && need_lis ? seed(frames_.back()->t) : std::nullopt;
   if (lis && config_.lis_bias_prior_sigma_acc > 0) lis_bias_ = lis->bias;
   // The ground holds the scale only while no LIS does (vio_config.hpp ground_height_m).
   ground_active_ = config_.ground_height_m > 0 && !lis;

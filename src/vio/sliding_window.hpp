@@ -111,7 +111,7 @@ class SlidingWindowEstimator {
   std::vector<Eigen::Isometry3d> cameraPoses() const;
   void optimize(FrameResult& result);
   void buildResiduals(Residuals& r, bool for_marginalization_of_oldest) const;
-  void addGroundFactor(Residuals& r, Feature& f) const;
+  void addGroundFactor(Residuals& r, Feature& f, const Eigen::Isometry3d& T_ic) const;  // while ground_active_
   void removeOutliers(FrameResult& result);
   // Why the window failed (empty: it did not). Too few tracked features are one reason unless result.coasting.
   std::string failure(const FrameResult& result) const;

@@ -96,6 +96,7 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
     r.items.push_back(
         {std::make_unique<TimeOffsetPrior>(config_.time_offset_sigma_s), nullptr, {const_cast<double*>(td_)}});
   const double sqrt_info = focal_px_ / config_.sigma_px;
+  const Eigen::Isometry3d T_ic = T_imu_cam();
   double* p_ic = const_cast<double*>(p_ic_);
   double* q_ic = const_cast<double*>(q_ic_);
   double* td = const_cast<double*>(td_);
@@ -117,7 +118,7 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
       r.items.push_back({std::move(cost), r.robust.get(), std::move(blocks)});
     }
     if (!f->lidar_anchor) {
-      addGroundFactor(r, *f);
+      if (ground_active_) addGroundFactor(r, *f, T_ic);
       continue;
     }
     ++r.with_lidar_depth;
@@ -139,15 +140,13 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
 // (vio_config.hpp ground_*): the point in the anchor IMU frame is R_ic n depth + p_ic. The gate is relative to the
 // camera's height above the surface, h + p_ic.z: a window whose scale is off by a fraction s puts the ground's
 // points s times that height off it.
-void SlidingWindowEstimator::addGroundFactor(Residuals& r, Feature& f) const {
+void SlidingWindowEstimator::addGroundFactor(Residuals& r, Feature& f, const Eigen::Isometry3d& T_ic) const {
   const double h = config_.ground_height_m;
-  if (!ground_active_ || !(f.depth > 0)) return;
+  if (!(f.depth > 0)) return;
   const Observation& oi = f.obs.front();
-  const Eigen::Quaterniond q_ic(q_ic_[3], q_ic_[0], q_ic_[1], q_ic_[2]);
-  const Eigen::Vector3d p_ic(p_ic_[0], p_ic_[1], p_ic_[2]);
-  const Eigen::Vector3d P_b = q_ic * (f.depth * oi.normalized.homogeneous()) + p_ic;
+  const Eigen::Vector3d P_b = T_ic * (f.depth * oi.normalized.homogeneous());
   const double range = P_b.head<2>().norm();
-  const double gate = config_.ground_gate_rel * std::max(h + p_ic.z(), 0.0);
+  const double gate = config_.ground_gate_rel * std::max(h + T_ic.translation().z(), 0.0);
   if (std::abs(P_b.z() + h) > gate || range > config_.ground_max_range_m) return;
   const double sigma = std::hypot(config_.ground_sigma_m, config_.ground_slope_sigma_rad * range);
   if (!r.ground_robust) r.ground_robust = std::make_unique<ceres::CauchyLoss>(1.0);

@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <random>
-#include <set>
 #include <vector>
 
 #include "vio/sliding_window.hpp"
