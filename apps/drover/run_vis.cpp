@@ -30,12 +30,30 @@ void warnEvenWhenQuiet(const std::string& message) {
 // A line of vis_frames.jsonl: what the VIS made of one camera frame.
 Json frameLine(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
-  return {{"t", toSeconds(r.t)},          {"initialized", r.initialized}, {"keyframe", r.keyframe},
-          {"detected", f.detected},       {"tracked", f.front_tracked},  {"features", r.features},
-          {"with_lidar_depth", r.with_lidar_depth}, {"on_ground", r.on_ground},
-          {"outliers", r.outliers},       {"iterations", r.iterations},
-          {"ms", {{"track", f.ms.track}, {"depth", f.ms.depth}, {"solve", f.ms.solve},
-                  {"marginalize", f.ms.marginalize}, {"total", f.ms.total}}}};
+  Json line = {{"t", toSeconds(r.t)},
+               {"initialized", r.initialized},
+               {"keyframe", r.keyframe},
+               {"detected", f.detected},
+               {"tracked", f.front_tracked},
+               {"features", r.features},
+               {"with_lidar_depth", r.with_lidar_depth},
+               {"on_ground", r.on_ground},
+               {"outliers", r.outliers},
+               {"iterations", r.iterations},
+               {"ms",
+                {{"track", f.ms.track},
+                 {"depth", f.ms.depth},
+                 {"solve", f.ms.solve},
+                 {"marginalize", f.ms.marginalize},
+                 {"total", f.ms.total}}}};
+  // The state behind the pose: a bias the window got wrong (a forward accelerometer bias at constant speed) shows in
+  // the trajectory only once the vision fails and the speed drifts; here it shows before.
+  if (r.initialized) {
+    line["speed"] = r.v_world.norm();
+    line["acc_bias"] = {r.bias.acc.x(), r.bias.acc.y(), r.bias.acc.z()};
+    line["gyro_bias"] = {r.bias.gyro.x(), r.bias.gyro.y(), r.bias.gyro.z()};
+  }
+  return line;
 }
 
 }  // namespace

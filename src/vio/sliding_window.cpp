@@ -178,6 +178,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
     result.event = why + ": window cleared, re-initialising";
     return result;
   }
+  checkGroundScale(result);       // may rescale the window to the ground's scale
   checkScaleOverHistory(result);  // may rescale the window: this frame's output is then the first of the new scale
   fillResult(result);
   if (config_.relative_covariance) {

@@ -162,6 +162,7 @@ class SlidingWindowEstimator {
   InitPrior init_prior_;
   // The LIS's biases at the newest frame (vio.lis_bias_prior_sigma_*): a prior in its solves only.
   std::optional<imu::ImuBias> lis_bias_;
+  Time last_ground_check_ = 0;
   bool ground_active_ = false;  // the ground factors are on: a ground height is set and no LIS seeds the window
   // The scale check after a visual initialisation (window_scale_check.cpp): the keyframes that left the window,
   // each with the IMU from the one before, and the IMU from the newest of them to the window's oldest frame.
@@ -173,6 +174,7 @@ class SlidingWindowEstimator {
   std::string scale_failure_;                  // a check found the scale off beyond repair: failure() says it
   void recordOldest();                         // before the oldest frame leaves the window
   void checkScaleOverHistory(FrameResult& result);
+  void checkGroundScale(FrameResult& result);  // window_ground_check.cpp
   void applyScale(const ScaleCheck& check, double rel_sigma);  // rel_sigma: the scale's, bias error included
   void setInitPrior(double sigma_rotation, double sigma_velocity, double sigma_gyro_bias, double sigma_acc_bias);
   // Coasting (no LIS; vio.coast_max_s): since when the newest frames have had too few tracked features.

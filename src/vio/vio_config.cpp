@@ -47,6 +47,9 @@ std::string VioConfig::validate() const {
     return "ground_sigma_m must be > 0 and ground_slope_sigma_rad >= 0";
   if (!positive(ground_gate_rel) || !(ground_gate_rel < 1) || !positive(ground_max_range_m))
     return "ground_gate_rel must be in (0, 1) and ground_max_range_m > 0";
+  if (!nonNegative(ground_check_every_s) || ground_check_min_points < 3 || !positive(ground_check_cluster_rel) ||
+      !(ground_check_cluster_rel < 0.5))
+    return "ground_check_every_s must be >= 0, ground_check_min_points >= 3, ground_check_cluster_rel in (0, 0.5)";
   if (!positive(robust_px)) return "robust_px must be > 0";
   if (!positive(outlier_px)) return "outlier_px must be > 0";
   if (min_observations < 2) return "min_observations must be >= 2";

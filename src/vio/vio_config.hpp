@@ -101,6 +101,17 @@ struct VioConfig {
   double ground_slope_sigma_rad = 0.02;  // [rad] the surface's slope under a feature relative to the body's plane
   double ground_gate_rel = 0.2;          // [1] of the camera's height above the surface
   double ground_max_range_m = 8;         // [m]
+  // The ground as a check of the scale (window_ground_check.cpp), while the ground factors are on: every
+  // ground_check_every_s, each point of the window below the camera and within ground_max_range_m implies a scale if
+  // it lies on the ground (its depth below the camera over the camera's height; scales within
+  // [1 / scale_check_max_change, scale_check_max_change] are considered). When at least
+  // ground_check_min_points of them agree within +-ground_check_cluster_rel, outnumber twice the points inside the
+  // ground factors' gate, and put the scale off by more than ground_gate_rel, the window is rescaled by it. A window
+  // whose scale left the gate (coasting through a dark stretch on the IMU, whose forward bias a constant-speed drive
+  // hides) is out of the ground factors' reach; this brings it back. 0: off.
+  double ground_check_every_s = 1;         // [s]
+  int ground_check_min_points = 10;
+  double ground_check_cluster_rel = 0.1;  // [1] half-width of the agreeing scales
   // Failure detection (VINS-Mono failureDetection).
   int min_tracked = 8;             // fewer features tracked into the newest frame: failure (with a LIS to seed it
                                    // again; alone, after coast_max_s)

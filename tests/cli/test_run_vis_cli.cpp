@@ -3,6 +3,7 @@
 // nearly still EuRoC snippet, on which the visual-inertial initialisation must refuse and say that it needs motion.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -95,6 +96,13 @@ TEST(VisRun, NoLidarRunsTheVisAloneAtMetricScaleAndWritesItsTrajectoryAndReport)
     keyframes += f["keyframe"].get<bool>() ? 1 : 0;
     tracked += f["tracked"].get<double>();
     EXPECT_TRUE(f["ms"].contains("solve")) << f;
+    // the state behind each estimated pose: the simulated IMU's biases are (0.002, -0.001, 0.0015) rad/s and
+    // (0.02, -0.03, 0.01) m/s^2, the straight drive's speed at most 1.2 m/s
+    EXPECT_EQ(f.contains("acc_bias"), f["initialized"].get<bool>()) << f;
+    if (!f["initialized"].get<bool>()) continue;
+    EXPECT_EQ(f["acc_bias"].size(), 3u);
+    EXPECT_LT(std::abs(f["gyro_bias"][0].get<double>() - 0.002), 0.005) << f;
+    EXPECT_LT(f["speed"].get<double>(), 2.0) << f;
   }
   EXPECT_EQ(initialised, est.size()) << "a pose in trajectory_vis.tum for every initialised frame";
   EXPECT_EQ(keyframes, v["keyframes"].get<std::size_t>());

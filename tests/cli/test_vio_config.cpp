@@ -49,6 +49,9 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   ground_slope_sigma_rad: 0.03
   ground_gate_rel: 0.3
   ground_max_range_m: 6
+  ground_check_every_s: 2
+  ground_check_min_points: 30
+  ground_check_cluster_rel: 0.05
 )"));
   EXPECT_EQ(c.window, 7);
   EXPECT_DOUBLE_EQ(c.min_parallax_px, 12.5);
@@ -77,6 +80,9 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   EXPECT_DOUBLE_EQ(c.ground_slope_sigma_rad, 0.03);
   EXPECT_DOUBLE_EQ(c.ground_gate_rel, 0.3);
   EXPECT_DOUBLE_EQ(c.ground_max_range_m, 6);
+  EXPECT_DOUBLE_EQ(c.ground_check_every_s, 2);
+  EXPECT_EQ(c.ground_check_min_points, 30);
+  EXPECT_DOUBLE_EQ(c.ground_check_cluster_rel, 0.05);
 }
 
 TEST(VioConfigIo, AFileWithoutTheSectionGivesTheDefaults) {
@@ -115,7 +121,10 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  scale_check_bias_sigma: -0.1\n", "scale_check_bias_sigma must be >= 0"},
            {"vio:\n  ground_height_m: -0.4\n", "ground_height_m must be >= 0"},
            {"vio:\n  ground_sigma_m: 0\n", "ground_sigma_m must be > 0"},
-           {"vio:\n  ground_gate_rel: 1.5\n", "ground_gate_rel must be in (0, 1)"}}) {
+           {"vio:\n  ground_gate_rel: 1.5\n", "ground_gate_rel must be in (0, 1)"},
+           {"vio:\n  ground_check_every_s: -1\n", "ground_check_every_s must be >= 0"},
+           {"vio:\n  ground_check_min_points: 2\n", "ground_check_min_points >= 3"},
+           {"vio:\n  ground_check_cluster_rel: 0.5\n", "ground_check_cluster_rel in (0, 0.5)"}}) {
     SCOPED_TRACE(yaml);
     const std::string path = write(dir, yaml);
     test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", "line", words});

@@ -83,31 +83,43 @@ struct DriveEnd {
   int min_on_ground = 1 << 30;
   int max_on_ground = 0;
   int resets = 0;
+  int rescales = 0;
 };
 
-// Seeded from the truth (as the LIS would), then the window alone for `seconds` (or beside the "LIS": `lis`).
-// lis: the seeder keeps returning the true state after the start, as a running LIS does.
-DriveEnd drive(unsigned seed, double ground_height, double seconds, bool floor = true, bool lis = false) {
-  StraightDrive scene(seed, floor);
+struct DriveOptions {
+  double ground_height = 0;   // [m] vio.ground_height_m
+  double seconds = 15;
+  bool floor = true;          // points on the floor as well as on the walls
+  bool lis = false;           // the seeder keeps returning the true state after the start, as a running LIS does
+  double seed_scale = 1;      // the seed's positions and velocity this many times the truth's (a wrong scale)
+  double ground_check_every_s = VioConfig{}.ground_check_every_s;  // [s] 0: no ground check
+};
+
+// Seeded from the truth (as the LIS would), then the window alone (or beside the "LIS").
+DriveEnd drive(unsigned seed, const DriveOptions& o) {
+  StraightDrive scene(seed, o.floor);
   VioConfig c;
   c.estimate_time_offset = false;
   c.max_features = 150;
-  c.ground_height_m = ground_height;
+  c.ground_height_m = o.ground_height;
+  c.ground_check_every_s = o.ground_check_every_s;
   SlidingWindowEstimator est(c, imu::PreintegrationConfig{}, scene.T_imu_cam, StraightDrive::kFocal);
   bool initialised = false;
   const Seeder seeder = [&](Time t) -> std::optional<SeedState> {
-    if (initialised && !lis) return std::nullopt;
+    if (initialised && !o.lis) return std::nullopt;
     SeedState s;
     s.T_world_imu = scene.pose(toSeconds(t));
-    s.v_world = Eigen::Vector3d(StraightDrive::kSpeed, 0, 0);
+    s.T_world_imu.translation().x() *= o.seed_scale;
+    s.v_world = Eigen::Vector3d(o.seed_scale * StraightDrive::kSpeed, 0, 0);
     return s;
   };
   DriveEnd end;
   double t_imu = 0;
-  for (double t = 0.05; t < seconds; t += 1.0 / 15) {
+  for (double t = 0.05; t < o.seconds; t += 1.0 / 15) {
     for (; t_imu <= t + 1e-9; t_imu += 0.005) est.addImu(scene.imu(t_imu));
     const FrameResult r = est.addFrame(fromSeconds(t), scene.features(t), seeder);
     end.resets += r.reset ? 1 : 0;
+    end.rescales += r.rescaled ? 1 : 0;
     if (!r.initialized) continue;
     if (initialised && t > 2) end.min_on_ground = std::min(end.min_on_ground, r.on_ground);
     end.max_on_ground = std::max(end.max_on_ground, r.on_ground);
@@ -120,7 +132,7 @@ DriveEnd drive(unsigned seed, double ground_height, double seconds, bool floor =
 }
 
 TEST(WindowGround, WithoutTheGroundHeightAConstantSpeedDriveLosesItsScale) {
-  const DriveEnd end = drive(1, 0.0, 15.0);
+  const DriveEnd end = drive(1, {});
   EXPECT_EQ(end.resets, 0);
   EXPECT_LT(end.speed, 0.9 * StraightDrive::kSpeed) << "the scene has acceleration the test did not intend";
   EXPECT_GT(end.position_error, 0.05 * end.path);
@@ -128,8 +140,9 @@ TEST(WindowGround, WithoutTheGroundHeightAConstantSpeedDriveLosesItsScale) {
 
 TEST(WindowGround, WithTheGroundHeightAConstantSpeedDriveKeepsItsScale) {
   for (unsigned seed : {1u, 2u}) {
-    const DriveEnd end = drive(seed, StraightDrive::kHeight, 15.0);
+    const DriveEnd end = drive(seed, {.ground_height = StraightDrive::kHeight});
     EXPECT_EQ(end.resets, 0) << seed;
+    EXPECT_EQ(end.rescales, 0) << seed << ": the ground check leaves a right scale alone";
     EXPECT_GT(end.min_on_ground, 0) << seed;
     EXPECT_NEAR(end.speed, StraightDrive::kSpeed, 0.02 * StraightDrive::kSpeed) << seed;
     EXPECT_LT(end.position_error, 0.01 * end.path) << seed;
@@ -137,7 +150,8 @@ TEST(WindowGround, WithTheGroundHeightAConstantSpeedDriveKeepsItsScale) {
 }
 
 TEST(WindowGround, FeaturesOffTheGroundAreNotHeldToIt) {
-  const DriveEnd end = drive(1, StraightDrive::kHeight, 5.0, false);  // walls only: points 0.3-3 m above the floor
+  // walls only: points 0.3-3 m above the floor
+  const DriveEnd end = drive(1, {.ground_height = StraightDrive::kHeight, .seconds = 5, .floor = false});
   EXPECT_EQ(end.resets, 0);
   EXPECT_EQ(end.max_on_ground, 0);
 }
@@ -145,9 +159,26 @@ TEST(WindowGround, FeaturesOffTheGroundAreNotHeldToIt) {
 TEST(WindowGround, BesideARunningLisTheGroundIsNotUsed) {
   // The lidar gives the scale there; on the farm course the ground factors beside the LIS cost the lvi-sam preset
   // 0.35 -> 2.35 m of APE.
-  const DriveEnd end = drive(1, StraightDrive::kHeight, 4.0, true, true);
+  const DriveEnd end = drive(1, {.ground_height = StraightDrive::kHeight, .seconds = 4, .lis = true});
   EXPECT_EQ(end.resets, 0);
   EXPECT_EQ(end.max_on_ground, 0);
+}
+
+// A window whose scale is 1.6 times the truth puts the floor's points 1.6 times the camera's height below it, out of
+// the ground factors' gate (20 %); they agree on that scale, so the ground check brings the window back.
+TEST(WindowGround, AWindowSeededAtTheWrongScaleIsBroughtBackByTheGroundCheck) {
+  const DriveEnd end = drive(1, {.ground_height = StraightDrive::kHeight, .seed_scale = 1.6});
+  EXPECT_EQ(end.resets, 0);
+  EXPECT_GE(end.rescales, 1);
+  EXPECT_GT(end.min_on_ground, 0) << "after the check the ground factors hold the floor again";
+  EXPECT_NEAR(end.speed, StraightDrive::kSpeed, 0.03 * StraightDrive::kSpeed);
+}
+
+TEST(WindowGround, WithoutTheGroundCheckAWindowSeededAtTheWrongScaleIsOutOfTheGroundFactorsReach) {
+  const DriveEnd end =
+      drive(1, {.ground_height = StraightDrive::kHeight, .seed_scale = 1.6, .ground_check_every_s = 0});
+  EXPECT_EQ(end.rescales, 0);
+  EXPECT_GT(std::abs(end.speed / StraightDrive::kSpeed - 1), 0.15);
 }
 
 }  // namespace

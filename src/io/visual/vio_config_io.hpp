@@ -12,7 +12,9 @@
 //        lis_sigma_acc_bias / align_sigma_acc_bias [m/s^2], seed_max_median_px [px], seed_min_observations,
 //        init_min_acc_excitation [m/s^2], init_max_scale_rel_sigma,
 //        scale_check_span_s [s], scale_check_every_s [s], scale_check_max_rel_sigma, scale_check_min_change,
-//        scale_check_max_change, scale_check_bias_sigma [m/s^2], min_tracked, coast_max_s [s], max_acc_bias [m/s^2],
+//        scale_check_max_change, scale_check_bias_sigma [m/s^2], ground_height_m [m], ground_sigma_m [m],
+//        ground_slope_sigma_rad [rad], ground_gate_rel, ground_max_range_m [m], ground_check_every_s [s],
+//        ground_check_min_points, ground_check_cluster_rel, min_tracked, coast_max_s [s], max_acc_bias [m/s^2],
 //        max_gyro_bias [rad/s], max_jump_m [m], max_height_jump_m [m], max_turn_deg [deg], max_speed [m/s],
 //        max_imu_gap_s [s]
 #include <string>
