@@ -1,5 +1,6 @@
 #include "apps/drover/run_vis.hpp"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -128,6 +129,27 @@ void RunVis::noteReset(Time t, const std::string& why) {
   if (resets_ <= kShownResets) spdlog::warn("VIS reset at {:.3f} s: {}", toSeconds(t), why);
   if (resets_ == kShownResets) spdlog::warn("VIS: further resets are counted in report.json, not shown");
   if (events_.size() < kMaxEvents) events_.push_back({t, "reset", why});
+  waiting_since_ = t;
+  waiting_reported_ = false;
+}
+
+// A VIS that stays out after a reset says why, once a wait is long enough to matter (the LIS runs without its help
+// meanwhile), and again with the last reason when it comes back: the first initialisation has its own line.
+void RunVis::noteWaiting(const vio::FrameResult& r) {
+  constexpr Time kReportAfter = 2'000'000'000;  // [ns]
+  if (!waiting_since_) return;
+  const Time waited = r.t - *waiting_since_;
+  if (r.just_initialized) {
+    if (waited >= kReportAfter && events_.size() < kMaxEvents)
+      events_.push_back({r.t, "waited", fmt::format("{:.1f} s since the reset; the last reason: {}",
+                                                    toSeconds(waited), waiting_.empty() ? "none given" : waiting_)});
+    waiting_since_.reset();
+    return;
+  }
+  if (waiting_reported_ || waited < kReportAfter || r.event.empty()) return;
+  waiting_reported_ = true;
+  spdlog::info("VIS {:.1f} s after its reset, {}", toSeconds(waited), r.event);
+  if (events_.size() < kMaxEvents) events_.push_back({r.t, "waiting", r.event});
 }
 
 // The LIS's state at a camera stamp: the IMU-rate pose, a velocity from the poses 40 ms apart (first order; the
@@ -172,11 +194,13 @@ void RunVis::record(const vio::VisFrame& f) {
     spdlog::info("VIS rescaled at {:.3f} s: {}", toSeconds(r.t), r.event);
     if (events_.size() < kMaxEvents) events_.push_back({r.t, "rescaled", r.event});
   } else if (r.just_initialized) {
+    noteWaiting(r);
     if (!first_init_) first_init_ = r.t;
     spdlog::info("VIS {} at {:.3f} s", r.event, toSeconds(r.t));
     if (events_.size() < kMaxEvents) events_.push_back({r.t, "initialized", r.event});
   } else if (!r.initialized && !r.event.empty()) {
     waiting_ = r.event;
+    noteWaiting(r);
   }
   if (r.coasting && !coasting_) {  // one event per stretch; the frames are counted
     spdlog::info("VIS at {:.3f} s: {}", toSeconds(r.t), r.event);

@@ -82,6 +82,7 @@ class RunVis {
  private:
   std::optional<vio::SeedState> seedAt(Time t, const pipeline::LidarOdometry& lis) const;
   void noteReset(Time t, const std::string& why);
+  void noteWaiting(const vio::FrameResult& r);  // a frame after a reset: a long wait reported, and its end
 
   std::unique_ptr<vio::VisualOdometry> own_;
   const vio::VisualOdometry* vo_ = nullptr;  // own_, or the System's
@@ -101,6 +102,9 @@ class RunVis {
   };
   std::vector<Event> events_;        // initialisations and resets (and the last "waiting" reason)
   std::string waiting_;              // why the VIS has not initialised yet (the newest reason)
+  // After a reset: since when the VIS has waited to initialise again, and whether that wait was reported yet.
+  std::optional<Time> waiting_since_;
+  bool waiting_reported_ = false;
   std::optional<pipeline::ScanOutcome> lis_state_;
   std::size_t frames_in_ = 0, frames_bad_ = 0, resets_ = 0, rescales_ = 0, coasted_ = 0;
   bool coasting_ = false;  // the previous frame coasted (vio::FrameResult::coasting)
