@@ -114,6 +114,7 @@ void SlidingWindowEstimator::reset() {
   history_.clear();
   history_next_imu_.clear();
   scale_failure_.clear();
+  pending_ground_scale_.reset();
   frames_.clear();
   features_.clear();
   prior_.reset();

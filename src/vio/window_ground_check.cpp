@@ -59,11 +59,19 @@ void SlidingWindowEstimator::checkGroundScale(FrameResult& result) {
     g.log_scales.push_back(std::log(scale));
   }
   const int min_points = config_.ground_check_min_points;
-  if (static_cast<int>(g.log_scales.size()) < min_points) return;
+  const auto no_proposal = [this] { pending_ground_scale_.reset(); };
+  if (static_cast<int>(g.log_scales.size()) < min_points) return no_proposal();
   std::sort(g.log_scales.begin(), g.log_scales.end());
   const auto [n, log_scale] = densestCluster(g.log_scales, std::log1p(config_.ground_check_cluster_rel));
-  if (static_cast<int>(n) < min_points || static_cast<int>(n) < 2 * g.in_gate) return;
-  if (std::abs(std::exp(log_scale) - 1) <= config_.ground_gate_rel) return;  // the ground factors' own business
+  if (static_cast<int>(n) < min_points || static_cast<int>(n) < 2 * g.in_gate) return no_proposal();
+  if (std::abs(std::exp(log_scale) - 1) <= config_.ground_gate_rel) return no_proposal();  // the ground factors' job
+  // Two checks in a row must agree: the points were solved a moment before, and a window that has just recovered by
+  // itself still has them at the old scale for a frame or two (the farm's seed 2 at 328 s).
+  const bool confirmed = pending_ground_scale_ &&
+                         std::abs(*pending_ground_scale_ - log_scale) <= std::log1p(config_.ground_check_cluster_rel);
+  pending_ground_scale_ = log_scale;
+  if (!confirmed) return;
+  pending_ground_scale_.reset();
   ScaleCheck check;
   check.ok = true;
   check.scale = std::exp(-log_scale);  // metric / window

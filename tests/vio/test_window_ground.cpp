@@ -80,10 +80,11 @@ struct DriveEnd {
   double speed = 0;           // [m/s] estimated at the end
   double position_error = 0;  // [m] at the end
   double path = 0;            // [m]
-  int min_on_ground = 1 << 30;
+  int min_on_ground = 1 << 30;  // after 3 s: a ground check confirms a scale at its second look (2 s)
   int max_on_ground = 0;
   int resets = 0;
   int rescales = 0;
+  double first_rescale_s = 0;  // [s] when the first rescale came (0: none)
 };
 
 struct DriveOptions {
@@ -120,8 +121,9 @@ DriveEnd drive(unsigned seed, const DriveOptions& o) {
     const FrameResult r = est.addFrame(fromSeconds(t), scene.features(t), seeder);
     end.resets += r.reset ? 1 : 0;
     end.rescales += r.rescaled ? 1 : 0;
+    if (r.rescaled && end.first_rescale_s == 0) end.first_rescale_s = t;
     if (!r.initialized) continue;
-    if (initialised && t > 2) end.min_on_ground = std::min(end.min_on_ground, r.on_ground);
+    if (initialised && t > 3) end.min_on_ground = std::min(end.min_on_ground, r.on_ground);
     end.max_on_ground = std::max(end.max_on_ground, r.on_ground);
     initialised = true;
     end.speed = r.v_world.norm();
@@ -170,6 +172,7 @@ TEST(WindowGround, AWindowSeededAtTheWrongScaleIsBroughtBackByTheGroundCheck) {
   const DriveEnd end = drive(1, {.ground_height = StraightDrive::kHeight, .seed_scale = 1.6});
   EXPECT_EQ(end.resets, 0);
   EXPECT_GE(end.rescales, 1);
+  EXPECT_GT(end.first_rescale_s, 1.9) << "a scale is acted on when the second check (1 s after the first) agrees";
   EXPECT_GT(end.min_on_ground, 0) << "after the check the ground factors hold the floor again";
   EXPECT_NEAR(end.speed, StraightDrive::kSpeed, 0.03 * StraightDrive::kSpeed);
 }
