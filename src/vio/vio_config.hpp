@@ -107,9 +107,9 @@ struct VioConfig {
   // [1 / scale_check_max_change, scale_check_max_change] are considered). When at least
   // ground_check_min_points of them agree within +-ground_check_cluster_rel, outnumber twice the points inside the
   // ground factors' gate, and put the scale off by more than ground_gate_rel at two checks in a row (the second within
-  // ground_check_cluster_rel of the first), the window is rescaled by it. A window
-  // whose scale left the gate (coasting through a dark stretch on the IMU, whose forward bias a constant-speed drive
-  // hides) is out of the ground factors' reach; this brings it back. 0: off.
+  // ground_check_cluster_rel of the first), the window is rescaled by it. A window whose scale left the gate
+  // (coasting through a dark stretch on the IMU, whose forward bias a constant-speed drive hides) is out of the
+  // ground factors' reach; this brings it back. 0: off.
   double ground_check_every_s = 1;         // [s]
   int ground_check_min_points = 10;
   double ground_check_cluster_rel = 0.1;  // [1] half-width of the agreeing scales
