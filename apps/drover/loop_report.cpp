@@ -80,7 +80,7 @@ Json eventJson(const pipeline::LoopEvent& e, const TruthLookup& truth, bool& cor
     // takes it): about 6 on average when the verifier's covariance is honest.
     geometry::Vector6d d;
     d << v.T_candidate_query.translation() - T_true.translation(), geometry::logSO3(err.linear());
-    j["nees"] = d.dot(v.information * d);
+    j["nees"] = d.dot(v.information() * d);
     j["true_distance_m"] = T_true.translation().norm();
     j["pose_error_m"] = et;
     j["pose_error_deg"] = er;

@@ -22,6 +22,11 @@ std::string LoopVerifierConfig::validate() const {
   return {};
 }
 
+geometry::Matrix6d LoopVerification::information() const {
+  const geometry::Matrix6d information = covariance.inverse();
+  return 0.5 * (information + information.transpose());
+}
+
 LoopVerifier::LoopVerifier(const LoopVerifierConfig& config) : config_(config), matcher_(config.matcher) {
   if (std::string e = config.validate(); !e.empty()) throw std::invalid_argument("loop verifier: " + e);
 }
@@ -41,8 +46,6 @@ void setCovariance(const lidar::MatchResult& r, const LoopVerifierConfig& c, Loo
   if (c.sigma_fitness_reference > 0 && r.fitness > c.sigma_fitness_reference)
     cov *= (r.fitness / c.sigma_fitness_reference) * (r.fitness / c.sigma_fitness_reference);
   v.covariance = cov;
-  v.information = cov.inverse();
-  v.information = 0.5 * (v.information + v.information.transpose());
 }
 
 std::string rejection(const LoopVerification& v, const lidar::MatchResult& r, const LoopVerifierConfig& c) {

@@ -59,10 +59,11 @@ struct LoopVerification {
   double inlier_ratio = 0;            // inliers / (query edges + planes)
   double correction_translation = 0;  // [m] |guess^-1 * solution| translation
   double correction_rotation = 0;     // [rad]
-  // Covariance and information of the decoupled error [dp (candidate frame, m); dphi (right, rad)] of
-  // T_candidate_query, as backend::RelativePoseFactor and PoseGraph edges take it.
+  // Covariance of the decoupled error [dp (candidate frame, m); dphi (right, rad)] of T_candidate_query, as
+  // backend::RelativePoseFactor and PoseGraph edges take it; information() is its inverse. The inverse is not
+  // stored: every verification is kept as a loop event (thousands over an hour), and 288 bytes each add up.
   geometry::Matrix6d covariance = geometry::Matrix6d::Identity();
-  geometry::Matrix6d information = geometry::Matrix6d::Identity();
+  geometry::Matrix6d information() const;
 };
 
 class LoopVerifier {

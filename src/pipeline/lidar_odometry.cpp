@@ -43,8 +43,8 @@ Trajectory LidarOdometry::trajectory() const {
   out.reserve(impl_->anchors.size());
   for (const Impl::Anchor& a : impl_->anchors) {
     Eigen::Isometry3d T_kf_sweep = Eigen::Isometry3d::Identity();
-    T_kf_sweep.linear() = a.q_kf_sweep.toRotationMatrix();
-    T_kf_sweep.translation() = a.p_kf_sweep;
+    T_kf_sweep.linear() = a.q_kf_sweep.cast<double>().normalized().toRotationMatrix();
+    T_kf_sweep.translation() = a.p_kf_sweep.cast<double>();
     out.push_back({a.t, impl_->map.keyframe(a.keyframe).T_world_lidar * T_kf_sweep});
   }
   return out;

@@ -33,15 +33,18 @@ struct LidarOdometry::Impl {
   LoopClosure loops;
   VisualYawHistory visual_yaw;  // the VIS's attitude: loop closure's shift prior (config.loop.visual_yaw_prior)
   // Per processed sweep: the keyframe it followed and its pose relative to it, so a loop correction of the
-  // keyframes carries every sweep with it and the trajectory is the keyframes' poses times these. Compact (80
-  // bytes, not a world pose and an anchor's 272): an hour of sweeps at 10 Hz is 2.9 MB, not 9.8 MB.
+  // keyframes carries every sweep with it and the trajectory is the keyframes' poses times these. Compact (48 bytes,
+  // not a world pose and an anchor's 272): an hour of sweeps at 10 Hz is 1.7 MB. Floats: the offset from a keyframe
+  // is metres, so single precision costs under a micrometre; the motion model keeps its exact copy
+  // (recent_kf_sweep). A deque, not a vector: an hour's vector doubles to twice what it holds and copies itself each
+  // time, where a deque adds a block at a time.
   struct Anchor {
     Time t = 0;
     std::uint32_t keyframe = 0;
-    Eigen::Quaterniond q_kf_sweep = Eigen::Quaterniond::Identity();
-    Eigen::Vector3d p_kf_sweep = Eigen::Vector3d::Zero();
+    Eigen::Quaternionf q_kf_sweep = Eigen::Quaternionf::Identity();
+    Eigen::Vector3f p_kf_sweep = Eigen::Vector3f::Zero();
   };
-  std::vector<Anchor> anchors;
+  std::deque<Anchor> anchors;
   std::vector<Eigen::Isometry3d> recent_kf_sweep;  // the anchors of `recent`, exact
   geometry::Matrix6d degenerate_since_kf = geometry::Matrix6d::Zero();  // sum of d d^T since the last keyframe
   int degenerate_run = 0;               // consecutive degenerate sweeps

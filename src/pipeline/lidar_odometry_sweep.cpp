@@ -318,8 +318,9 @@ Eigen::Isometry3d LidarOdometry::Impl::correctKeyframes(const std::vector<Eigen:
 void LidarOdometry::Impl::record(const ScanOutcome& out) {
   const std::size_t kf = map.size() - 1;
   const Eigen::Isometry3d T_kf_sweep = map.keyframe(kf).T_world_lidar.inverse() * out.T_world_lidar;
-  anchors.push_back({out.t, static_cast<std::uint32_t>(kf), Eigen::Quaterniond(T_kf_sweep.linear()).normalized(),
-                     T_kf_sweep.translation()});
+  anchors.push_back({out.t, static_cast<std::uint32_t>(kf),
+                     Eigen::Quaterniond(T_kf_sweep.linear()).normalized().cast<float>(),
+                     T_kf_sweep.translation().cast<float>()});
   recent.push_back({out.t, out.T_world_lidar});
   recent_kf_sweep.push_back(T_kf_sweep);
   if (recent.size() > 2) {

@@ -261,7 +261,7 @@ bool LoopClosure::Impl::tryCandidate(const lidar::LocalMap& map, std::size_t ind
     const Eigen::Vector3d before = graph.pose(static_cast<int>(index)).translation();
     const std::size_t edge =
         graph.addEdge(static_cast<int>(c.index), static_cast<int>(index), e.verification.T_candidate_query,
-                      e.verification.information, backend::EdgeKind::kLoop);
+                      e.verification.information(), backend::EdgeKind::kLoop);
     const backend::PoseGraphResult r = graph.optimize();
     e.graph_initial_cost = r.initial_cost;
     e.graph_final_cost = r.final_cost;

@@ -78,8 +78,8 @@ TEST(LoopVerifier, CovarianceIncludesTheFloorsAndIsTheInverseOfTheInformation) {
   ASSERT_TRUE(v.accepted) << v.reason;
   for (int i = 0; i < 3; ++i) EXPECT_GE(v.covariance(i, i), 0.2 * 0.2);
   for (int i = 3; i < 6; ++i) EXPECT_GE(v.covariance(i, i), 0.01 * 0.01);
-  EXPECT_LT((v.covariance * v.information - geometry::Matrix6d::Identity()).norm(), 1e-6);
-  EXPECT_LT((v.information - v.information.transpose()).norm(), 1e-9 * v.information.norm());
+  EXPECT_LT((v.covariance * v.information() - geometry::Matrix6d::Identity()).norm(), 1e-6);
+  EXPECT_LT((v.information() - v.information().transpose()).norm(), 1e-9 * v.information().norm());
 }
 
 // A fit worse than sigma_fitness_reference widens the whole covariance by (fitness / reference)^2; a better one, or
@@ -95,7 +95,7 @@ TEST(LoopVerifier, AFitWorseThanTheFitnessReferenceWidensTheCovarianceByTheSquar
   c.sigma_fitness_reference = plain.fitness / 3;  // this fit is 3x worse than the reference
   const LoopVerification wide = LoopVerifier(c).verify(query, submap, 0, pose(1.2, 1, 12));
   EXPECT_LT((wide.covariance - 9.0 * plain.covariance).norm(), 1e-9 * plain.covariance.norm());
-  EXPECT_LT((wide.covariance * wide.information - geometry::Matrix6d::Identity()).norm(), 1e-6);
+  EXPECT_LT((wide.covariance * wide.information() - geometry::Matrix6d::Identity()).norm(), 1e-6);
   EXPECT_EQ(wide.T_candidate_query.matrix(), plain.T_candidate_query.matrix()) << "only the covariance changes";
   c.sigma_fitness_reference = plain.fitness * 2;  // a better fit than the reference
   EXPECT_EQ(LoopVerifier(c).verify(query, submap, 0, pose(1.2, 1, 12)).covariance, plain.covariance);
