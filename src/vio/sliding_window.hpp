@@ -164,6 +164,7 @@ class SlidingWindowEstimator {
   std::optional<imu::ImuBias> lis_bias_;
   Time last_ground_check_ = 0;
   std::optional<double> pending_ground_scale_;  // log of the scale the previous ground check found, to be confirmed
+  bool zero_bias_prior_ = false;  // vio.acc_bias_prior_sigma is set and no LIS seeds the window
   bool ground_active_ = false;  // the ground factors are on: a ground height is set and no LIS seeds the window
   // The scale check after a visual initialisation (window_scale_check.cpp): the keyframes that left the window,
   // each with the IMU from the one before, and the IMU from the newest of them to the window's oldest frame.

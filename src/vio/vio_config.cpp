@@ -68,6 +68,7 @@ std::string VioConfig::validate() const {
   if (!nonNegative(lis_bias_prior_sigma_gyro) || !nonNegative(lis_bias_prior_sigma_acc) ||
       (lis_bias_prior_sigma_gyro > 0) != (lis_bias_prior_sigma_acc > 0))
     return "lis_bias_prior_sigma_gyro and lis_bias_prior_sigma_acc must be >= 0, and both 0 (off) or both > 0";
+  if (!nonNegative(acc_bias_prior_sigma)) return "acc_bias_prior_sigma must be >= 0 (0: off)";
   if (!nonNegative(init_min_acc_excitation)) return "init_min_acc_excitation must be >= 0";
   if (!positive(init_max_scale_rel_sigma)) return "init_max_scale_rel_sigma must be > 0";
   if (!nonNegative(scale_check_span_s)) return "scale_check_span_s must be >= 0";

@@ -59,6 +59,11 @@ struct VioConfig {
   // accelerometer-bias pair that a straight drive leaves unobservable to the window. 0: off.
   double lis_bias_prior_sigma_gyro = 0;  // [rad/s]
   double lis_bias_prior_sigma_acc = 0;   // [m/s^2]
+  // Without a LIS, the accelerometer's turn-on bias (1 sigma per axis, from the IMU's datasheet) as a prior toward
+  // zero on the newest frame's accelerometer bias at every solve, never marginalised. At constant velocity the
+  // window cannot tell a bias along an axis from a tilt of gravity (b = g x tilt: 0.17 m/s^2 per degree), so without
+  // it the pair wanders wherever the tracks' noise pushes it, and a tilted body makes the path climb or dive. 0: off.
+  double acc_bias_prior_sigma = 0;  // [m/s^2]
   // A seed is refused when the window's lidar-anchored tracks, moved by the LIS's poses, reproject to a median
   // error above seed_max_median_px [px at focal_px] over at least seed_min_observations observations (sliding
   // tracks on a textureless surface, or a LIS whose velocity drifted; vio/seed_agreement.hpp). 0 disables.

@@ -82,6 +82,12 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
                                                                   config_.lis_bias_prior_sigma_acc),
                        nullptr, {frames_.back()->bias}});
   }
+  if (!oldest_only && zero_bias_prior_) {  // the datasheet's turn-on bias; the gyro's is observable: left free
+    constexpr double kFreeGyroSigma = 1.0;   // [rad/s]
+    r.items.push_back({std::make_unique<backend::BiasPriorFactor>(backend::Vector6d::Zero(), kFreeGyroSigma,
+                                                                  config_.acc_bias_prior_sigma),
+                       nullptr, {frames_.back()->bias}});
+  }
   // The longest tracks first (they constrain the window most), up to max_features.
   std::vector<Feature*> used;
   const int newest = static_cast<int>(n) - 1;

@@ -44,6 +44,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   imu_midpoint: false
   lis_bias_prior_sigma_gyro: 0.001
   lis_bias_prior_sigma_acc: 0.02
+  acc_bias_prior_sigma: 0.08
   ground_height_m: 0.65
   ground_sigma_m: 0.05
   ground_slope_sigma_rad: 0.03
@@ -75,6 +76,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   EXPECT_FALSE(c.imu_midpoint);
   EXPECT_DOUBLE_EQ(c.lis_bias_prior_sigma_gyro, 0.001);
   EXPECT_DOUBLE_EQ(c.lis_bias_prior_sigma_acc, 0.02);
+  EXPECT_DOUBLE_EQ(c.acc_bias_prior_sigma, 0.08);
   EXPECT_DOUBLE_EQ(c.ground_height_m, 0.65);
   EXPECT_DOUBLE_EQ(c.ground_sigma_m, 0.05);
   EXPECT_DOUBLE_EQ(c.ground_slope_sigma_rad, 0.03);
@@ -119,6 +121,7 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  scale_check_max_change: 1\n", "scale_check_max_change must be > 1"},
            {"vio:\n  coast_max_s: -1\n", "coast_max_s must be >= 0"},
            {"vio:\n  scale_check_bias_sigma: -0.1\n", "scale_check_bias_sigma must be >= 0"},
+           {"vio:\n  acc_bias_prior_sigma: -0.05\n", "acc_bias_prior_sigma must be >= 0"},
            {"vio:\n  ground_height_m: -0.4\n", "ground_height_m must be >= 0"},
            {"vio:\n  ground_sigma_m: 0\n", "ground_sigma_m must be > 0"},
            {"vio:\n  ground_gate_rel: 1.5\n", "ground_gate_rel must be in (0, 1)"},

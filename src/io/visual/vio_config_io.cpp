@@ -60,6 +60,7 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
       .bind("lis_sigma_acc_bias", c.lis_sigma_acc_bias)
       .bind("lis_bias_prior_sigma_gyro", c.lis_bias_prior_sigma_gyro)
       .bind("lis_bias_prior_sigma_acc", c.lis_bias_prior_sigma_acc)
+      .bind("acc_bias_prior_sigma", c.acc_bias_prior_sigma)
       .bind("align_sigma_rotation_rad", c.align_sigma_rotation_rad)
       .bind("align_sigma_velocity", c.align_sigma_velocity)
       .bind("align_sigma_gyro_bias", c.align_sigma_gyro_bias)
