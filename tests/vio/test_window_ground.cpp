@@ -18,7 +18,7 @@ namespace {
 // Straight along world x at `speed`, the IMU `height` above a flat floor at z = 0, no vibration; walls 3-6 m to
 // either side with points 0.3-3 m high, and (optionally) points on the floor. A forward camera 0.2 m ahead of and
 // 0.1 m above the IMU. The IMU carries white noise at the preintegration's densities and constant biases; each
-// observation 0.5 px of noise at a 460 px focal length.
+// observation pixel_sigma (0.5 px unless a test says) of noise at a 460 px focal length.
 class StraightDrive {
  public:
   static constexpr double kSpeed = 1.2;    // [m/s]
@@ -26,7 +26,7 @@ class StraightDrive {
   static constexpr double kFocal = 460.0;  // [px]
   static constexpr double kAccBiasX = 0.03;  // [m/s^2] the accelerometer's true bias along x
 
-  StraightDrive(unsigned seed, bool floor) : rng_(seed) {
+  StraightDrive(unsigned seed, bool floor, double pixel_sigma) : rng_(seed), pixel_sigma_(pixel_sigma) {
     Eigen::Matrix3d R;
     R << 0, 0, 1, -1, 0, 0, 0, -1, 0;
     T_imu_cam.setIdentity();
@@ -58,7 +58,7 @@ class StraightDrive {
   }
 
   std::vector<FrameFeature> features(double t) {
-    std::normal_distribution<double> n(0, 0.5 / kFocal);
+    std::normal_distribution<double> n(0, pixel_sigma_ / kFocal);
     std::vector<FrameFeature> out;
     const Eigen::Isometry3d T_cw = (pose(t) * T_imu_cam).inverse();
     for (std::size_t k = 0; k < points_.size() && out.size() < 150; ++k) {
@@ -77,6 +77,7 @@ class StraightDrive {
 
  private:
   std::mt19937 rng_;
+  double pixel_sigma_;  // [px]
   std::vector<Eigen::Vector3d> points_;
 };
 
@@ -102,11 +103,12 @@ struct DriveOptions {
   double ground_check_every_s = VioConfig{}.ground_check_every_s;  // [s] 0: no ground check
   double seed_pitch = 0;            // [rad] the seed's body pitched up by this, with the x bias that explains it
   double acc_bias_prior_sigma = 0;  // [m/s^2] vio.acc_bias_prior_sigma
+  double pixel_sigma = 0.5;         // [px] the observations' noise
 };
 
 // Seeded from the truth (as the LIS would), then the window alone (or beside the "LIS").
 DriveEnd drive(unsigned seed, const DriveOptions& o) {
-  StraightDrive scene(seed, o.floor);
+  StraightDrive scene(seed, o.floor, o.pixel_sigma);
   VioConfig c;
   c.estimate_time_offset = false;
   c.max_features = 150;
@@ -151,11 +153,23 @@ DriveEnd drive(unsigned seed, const DriveOptions& o) {
   return end;
 }
 
-TEST(WindowGround, WithoutTheGroundHeightAConstantSpeedDriveLosesItsScale) {
-  const DriveEnd end = drive(1, {});
-  EXPECT_EQ(end.resets, 0);
-  EXPECT_LT(end.speed, 0.9 * StraightDrive::kSpeed) << "the scene has acceleration the test did not intend";
-  EXPECT_GT(end.position_error, 0.05 * end.path);
+// Why the speed falls away rather than wandering either way: at constant velocity the window's scale is free, and a
+// smaller one shrinks the accelerations that the tracks' pixel noise puts into the poses, which the IMU (measuring
+// none) penalises: the scale is pulled towards zero the more, the noisier the tracks (regression dilution). Without
+// pixel noise the same drive keeps more of its speed, on both seeds (measured: 0.64 / 1.02 m/s at 0.5 px against
+// 1.10 / 1.37 m/s at none; the IMU's own noise walks it either way). On the simulated straight course, its rendered
+// tracks drifting ~0.14 px a frame, the VIS alone lost 18 % of its speed in 30 s without the ground height.
+TEST(WindowGround, WithoutTheGroundHeightAConstantSpeedDriveLosesItsScaleToThePixelNoise) {
+  for (unsigned seed : {1u, 2u}) {
+    const DriveEnd noisy = drive(seed, {});
+    const DriveEnd exact = drive(seed, {.pixel_sigma = 0});
+    std::printf("seed %u: end speed %.3f m/s with 0.5 px of noise, %.3f m/s without\n", seed, noisy.speed, exact.speed);
+    EXPECT_EQ(noisy.resets + exact.resets, 0) << seed;
+    EXPECT_LT(noisy.speed, exact.speed - 0.2) << seed;
+    if (seed != 1) continue;
+    EXPECT_LT(noisy.speed, 0.9 * StraightDrive::kSpeed) << "the scene has acceleration the test did not intend";
+    EXPECT_GT(noisy.position_error, 0.05 * noisy.path);
+  }
 }
 
 TEST(WindowGround, WithTheGroundHeightAConstantSpeedDriveKeepsItsScale) {
