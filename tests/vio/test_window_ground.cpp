@@ -158,7 +158,7 @@ DriveEnd drive(unsigned seed, const DriveOptions& o) {
 // none) penalises: the scale is pulled towards zero the more, the noisier the tracks (regression dilution). Without
 // pixel noise the same drive keeps more of its speed, on both seeds (measured: 0.64 / 1.02 m/s at 0.5 px against
 // 1.10 / 1.37 m/s at none; the IMU's own noise walks it either way). On the simulated straight course, its rendered
-// tracks drifting ~0.14 px a frame, the VIS alone lost 18 % of its speed in 30 s without the ground height.
+// tracks drifting ~0.14 px a frame, the VIS alone lost 18 % of its speed in 32 s without the ground height.
 TEST(WindowGround, WithoutTheGroundHeightAConstantSpeedDriveLosesItsScaleToThePixelNoise) {
   for (unsigned seed : {1u, 2u}) {
     const DriveEnd noisy = drive(seed, {});
