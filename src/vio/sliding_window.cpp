@@ -168,9 +168,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
       config_.lis_bias_prior_sigma_acc > 0 || config_.ground_height_m > 0 || config_.acc_bias_prior_sigma > 0;
   const std::optional<SeedState> lis = seed && need_lis ? seed(frames_.back()->t) : std::nullopt;
   if (lis && config_.lis_bias_prior_sigma_acc > 0) lis_bias_ = lis->bias;
-  // The ground holds the scale only while no LIS does (vio_config.hpp ground_height_m).
-  ground_active_ = config_.ground_height_m > 0 && !lis;
-  zero_bias_prior_ = config_.acc_bias_prior_sigma > 0 && !lis;  // beside the LIS its biases seed the window
+  alone_ = !lis;  // the ground and the turn-on bias prior act only then (vio_config.hpp)
   optimize(result);
   removeOutliers(result);
   checkCoasting(result, static_cast<bool>(seed));

@@ -111,7 +111,7 @@ class SlidingWindowEstimator {
   std::vector<Eigen::Isometry3d> cameraPoses() const;
   void optimize(FrameResult& result);
   void buildResiduals(Residuals& r, bool for_marginalization_of_oldest) const;
-  void addGroundFactor(Residuals& r, Feature& f, const Eigen::Isometry3d& T_ic) const;  // while ground_active_
+  void addGroundFactor(Residuals& r, Feature& f, const Eigen::Isometry3d& T_ic) const;  // alone_, a ground height set
   void removeOutliers(FrameResult& result);
   // Why the window failed (empty: it did not). Too few tracked features are one reason unless result.coasting.
   std::string failure(const FrameResult& result) const;
@@ -164,8 +164,9 @@ class SlidingWindowEstimator {
   std::optional<imu::ImuBias> lis_bias_;
   Time last_ground_check_ = 0;
   std::optional<double> pending_ground_scale_;  // log of the scale the previous ground check found, to be confirmed
-  bool zero_bias_prior_ = false;  // vio.acc_bias_prior_sigma is set and no LIS seeds the window
-  bool ground_active_ = false;  // the ground factors are on: a ground height is set and no LIS seeds the window
+  // No LIS seeds the window at this frame: only then do the ground factors (ground_height_m) and the turn-on bias
+  // prior (acc_bias_prior_sigma) act; beside the LIS its lidar gives the scale and its biases seed the window.
+  bool alone_ = false;
   // The scale check after a visual initialisation (window_scale_check.cpp): the keyframes that left the window,
   // each with the IMU from the one before, and the IMU from the newest of them to the window's oldest frame.
   std::deque<ScaleCheckFrame> history_;

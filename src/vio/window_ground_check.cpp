@@ -37,7 +37,7 @@ std::pair<std::size_t, double> densestCluster(const std::vector<double>& sorted,
 }  // namespace
 
 void SlidingWindowEstimator::checkGroundScale(FrameResult& result) {
-  if (!ground_active_ || !(config_.ground_check_every_s > 0)) return;
+  if (!alone_ || !(config_.ground_height_m > 0) || !(config_.ground_check_every_s > 0)) return;
   if (result.t - last_ground_check_ < fromSeconds(config_.ground_check_every_s)) return;
   last_ground_check_ = result.t;
   const Eigen::Isometry3d T_ic = T_imu_cam();

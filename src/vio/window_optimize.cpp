@@ -82,7 +82,8 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
                                                                   config_.lis_bias_prior_sigma_acc),
                        nullptr, {frames_.back()->bias}});
   }
-  if (!oldest_only && zero_bias_prior_) {  // the datasheet's turn-on bias; the gyro's is observable: left free
+  // The datasheet's turn-on bias; the gyro's is observable: left free.
+  if (!oldest_only && alone_ && config_.acc_bias_prior_sigma > 0) {
     constexpr double kFreeGyroSigma = 1.0;   // [rad/s]
     r.items.push_back({std::make_unique<backend::BiasPriorFactor>(backend::Vector6d::Zero(), kFreeGyroSigma,
                                                                   config_.acc_bias_prior_sigma),
@@ -124,7 +125,7 @@ void SlidingWindowEstimator::buildResiduals(Residuals& r, bool oldest_only) cons
       r.items.push_back({std::move(cost), r.robust.get(), std::move(blocks)});
     }
     if (!f->lidar_anchor) {
-      if (ground_active_) addGroundFactor(r, *f, T_ic);
+      if (alone_ && config_.ground_height_m > 0) addGroundFactor(r, *f, T_ic);
       continue;
     }
     ++r.with_lidar_depth;
