@@ -35,8 +35,10 @@ struct VisSetup {
 };
 // Reads the `visual:` and `vio:` sections (defaults without a config). SuperPoint whose weights cannot be loaded
 // falls back to Shi-Tomasi with a warning.
-// A preset (run_preset.hpp) overrides the methods the config chose.
-VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method = {});
+// A preset (run_preset.hpp) overrides the methods the config chose. A relative weights path is the working
+// directory's, else the one beside the config file, else, when base_dir is given, base_dir's (drover_ros's
+// ~working_dir: roslaunch starts a node in ROS_HOME, where the shipped configs' path finds nothing).
+VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method = {}, const std::string& base_dir = {});
 
 class RunVis {
  public:

@@ -1,6 +1,7 @@
 #include "apps/drover_ros/drover_node.hpp"
 
 #include <cmath>
+#include <filesystem>
 #include <stdexcept>
 
 #include "apps/drover_ros/ros_conversions.hpp"
@@ -46,6 +47,9 @@ NodeParams NodeParams::read(const ::ros::NodeHandle& pnh) {
   p.live.config = p.config;
   pnh.param("use_camera", p.live.use_camera, p.live.use_camera);
   pnh.param("use_loop", p.live.use_loop, p.live.use_loop);
+  pnh.param("working_dir", p.live.working_dir, p.live.working_dir);
+  if (std::error_code ec; !p.live.working_dir.empty() && !std::filesystem::is_directory(p.live.working_dir, ec))
+    throw std::invalid_argument("~working_dir is not a folder: " + p.live.working_dir);
   int queue = static_cast<int>(p.live.sweep_queue);
   pnh.param("sweep_queue", queue, queue);
   if (queue < 1 || queue > 100) throw std::invalid_argument("~sweep_queue must be 1 ... 100, got " + std::to_string(queue));
@@ -114,7 +118,8 @@ void DroverNode::subscribe() {
     topics += ", camera " + p.image_topic;
   }
   ROS_INFO_STREAM("drover: " << params_.config << ": subscribed to " << topics << "; body frame "
-                             << session_->bodyFrame() << (session_->visRuns() ? ", VIS on" : ", VIS off"));
+                             << session_->bodyFrame()
+                             << (session_->visRuns() ? ", VIS on with " + session_->visDetector() : ", VIS off"));
 }
 
 void DroverNode::publishStatic() {

@@ -49,7 +49,7 @@ struct NodeParams {
   double path_period = 1.0;  // [s] between path and loop-marker publications (wall time)
   std::string save_dir;      // ~save_dir: where ~save and ~save_on_exit write the run folder
   bool save_on_exit = false;
-  live::LiveOptions live;    // ~use_camera, ~use_loop, ~sweep_queue
+  live::LiveOptions live;    // ~use_camera, ~use_loop, ~sweep_queue, ~working_dir
   // Reads the private parameters; throws std::invalid_argument naming a bad one.
   static NodeParams read(const ::ros::NodeHandle& pnh);
 };

@@ -109,7 +109,7 @@ LiveSession::Impl::Impl(const LiveOptions& o, LiveCallbacks c) : options(o), cb(
   // The VIS runs beside the LIS as in drover run: with images, an IMU and usable intrinsics.
   const std::string no_intrinsics = visual::validateIntrinsics(platform.calibration.camera);
   if (options.use_camera && platform.load_images && platform.load_imu && no_intrinsics.empty()) {
-    cli::VisSetup setup = cli::loadVisSetup(options.config);
+    cli::VisSetup setup = cli::loadVisSetup(options.config, {}, options.working_dir);
     config.vis = setup.config;
     detector = std::move(setup.detector);
     detector_name = setup.detector_name;
@@ -194,6 +194,7 @@ LiveSession::~LiveSession() { shutdown(); }
 
 const io::DatasetOptions& LiveSession::platform() const { return impl_->platform; }
 bool LiveSession::visRuns() const { return impl_->config.vis.has_value(); }
+const std::string& LiveSession::visDetector() const { return impl_->detector_name; }
 const std::string& LiveSession::bodyFrame() const { return impl_->body_frame; }
 
 // Pushes under the shared lock. A measurement whose stream's clock jumped back first restarts the System (a

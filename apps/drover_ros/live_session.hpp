@@ -26,6 +26,10 @@ struct LiveOptions {
   bool use_camera = true;       // run the VIS when the platform loads images, has intrinsics and an IMU
   bool use_loop = true;         // loop closure (when the config's odometry.loop.enabled also says so)
   std::size_t sweep_queue = 2;  // [sweeps] waiting for the LIS at most (pipeline::LiveConfig)
+  // A relative SuperPoint weights path in the config that neither the working directory nor the config's folder
+  // holds is looked for here (cli::loadVisSetup): the launch file gives the repository, the folder drover run's
+  // shipped paths are written for. Empty: not looked for.
+  std::string working_dir;
 };
 
 // The body's pose (and velocity when known) in the world frame at t.
@@ -82,6 +86,7 @@ class LiveSession {
 
   const io::DatasetOptions& platform() const;  // topics, which sensors to use, calibration
   bool visRuns() const;                          // the VIS runs beside the LIS
+  const std::string& visDetector() const;        // its detector ("superpoint", "shi-tomasi (SuperPoint ...)")
   const std::string& bodyFrame() const;          // "imu" or "lidar"
 
   // Thread-safe; one thread per sensor keeps each stream in order. Ignored after shutdown(). When a stream's clock

@@ -18,6 +18,7 @@
 #include "io/dataset.hpp"
 #include "io/trajectory_io.hpp"
 #include "support/cli.hpp"
+#include "support/shared_data.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::test {
@@ -217,13 +218,36 @@ TEST(LiveSession, SavesAndViewsWhileSweepsAreProcessedEachLeaveAValidRunFolder) 
 TEST(LiveSession, PlatformWithoutLidarIsRefusedNamingTheConfig) {
   const TempDir tmp;
   writeText(tmp / "no_lidar.yaml", "dataset:\n  load_lidar: false\n");
+  live::LiveOptions o;
+  o.config = (tmp / "no_lidar.yaml").string();
   try {
-    live::LiveSession session(live::LiveOptions{(tmp / "no_lidar.yaml").string()}, {});
+    live::LiveSession session(o, {});
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
     EXPECT_TRUE(contains(e.what(), "no_lidar.yaml")) << e.what();
     EXPECT_TRUE(contains(e.what(), "load_lidar")) << e.what();
   }
+}
+
+// roslaunch starts the node in ROS_HOME, where the shipped configs' relative SuperPoint weights path (written for
+// drover run in the repository) finds nothing, nor does it beside the config: the session then says Shi-Tomasi. The
+// launch file's ~working_dir (the repository by default) is where the path is looked for next.
+TEST(LiveSession, TheShippedConfigsSuperPointWeightsAreFoundFromTheWorkingDirWhereverTheNodeStarts) {
+  DROVER_REQUIRE_SHARED(sharedDir() / "models" / "superpoint_v1.onnx");
+  const fs::path config = fs::path(DROVER_SOURCE_DIR) / "config" / "farm_sim_bag.yaml";
+  ASSERT_FALSE(fs::exists("../shared/models/superpoint_v1.onnx")) << "the test needs a working directory ("
+                                                                    << fs::current_path() << ") without the weights";
+  live::LiveOptions o;
+  o.config = config.string();
+  {
+    const live::LiveSession session(o, {});
+    ASSERT_TRUE(session.visRuns());
+    EXPECT_EQ(session.visDetector(), "shi-tomasi (SuperPoint unavailable)");
+  }
+  o.working_dir = DROVER_SOURCE_DIR;
+  const live::LiveSession session(o, {});
+  ASSERT_TRUE(session.visRuns());
+  EXPECT_EQ(session.visDetector(), "superpoint");
 }
 
 }  // namespace

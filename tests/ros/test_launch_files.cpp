@@ -28,6 +28,23 @@ TEST(RosLaunchFiles, RoslaunchFindsTheBuiltNodeThroughTheBuildFolderOnRosPackage
   EXPECT_TRUE(contains(r.output, std::string(DROVER_ROS_BINARY) + " __name:=drover")) << r.output;
 }
 
+// The shipped configs' SuperPoint weights path is relative, written for drover run in the repository; the node
+// starts in ROS_HOME, so the launch file points ~working_dir at the repository (live::LiveOptions::working_dir).
+TEST(RosLaunchFiles, TheNodesWorkingDirIsTheRepositoryThatTheShippedWeightsPathIsWrittenFor) {
+  const TempDir tmp;
+  const CliResult r = runShell("ROS_HOME=" + tmp.path().string() + " ROS_LOG_DIR=" + tmp.path().string() +
+                               " roslaunch --dump-params " + (kRos / "launch" / "drover.launch").string() +
+                               " config:=/abs/platform.yaml rviz:=false 2>&1");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const YAML::Node params = YAML::Load(r.output);
+  ASSERT_TRUE(params["/drover/working_dir"]) << r.output;
+  EXPECT_TRUE(fs::equivalent(params["/drover/working_dir"].as<std::string>(), DROVER_SOURCE_DIR)) << r.output;
+  EXPECT_EQ(YAML::LoadFile(std::string(DROVER_SOURCE_DIR) + "/config/farm_sim_bag.yaml")["visual"]["detector"]["superpoint"]
+                ["weights"]
+                    .as<std::string>(),
+            "../shared/models/superpoint_v1.onnx");
+}
+
 TEST(RosLaunchFiles, LaunchFileWithoutTheConfigArgumentIsRefusedByRoslaunch) {
   const TempDir tmp;
   const CliResult r = runShell("ROS_HOME=" + tmp.path().string() + " ROS_LOG_DIR=" + tmp.path().string() +
