@@ -51,6 +51,8 @@ void readKey(const YAML::Node& n, const std::string& key, const std::string& fil
     s.lidar_model = m;
   } else if (key == "lidar_columns") {
     s.lidar_columns = static_cast<int>(parseInteger(scalar(n, key, file), 1, 100000, source(n, key, file)));
+  } else if (key == "camera_pixel_samples") {
+    s.camera_pixel_samples = static_cast<int>(parseInteger(scalar(n, key, file), 1, 4, source(n, key, file)));
   } else if (key == "lidar_time_offset" || key == "camera_time_offset") {
     Range r{-kMaxSimTimeOffsetS, kMaxSimTimeOffsetS};
     r.unit = "s";
@@ -85,7 +87,8 @@ SimConfigSettings loadSimConfigSettings(const std::string& yaml_path) {
   if (!sim.IsMap()) fail(yaml_path, "key 'sim'", "expected a map of settings");
   static const std::vector<std::string> known = {
       "lidar_model",    "lidar_rate_hz", "lidar_columns",        "camera_rate_hz",    "camera_color",
-      "imu_rate_hz",    "noise",         "ground_truth_rate_hz", "lidar_time_offset", "camera_time_offset"};
+      "imu_rate_hz",    "noise",         "ground_truth_rate_hz", "lidar_time_offset", "camera_time_offset",
+      "camera_pixel_samples"};
   for (const auto& kv : sim) {
     const std::string key = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), key) == known.end()) {

@@ -51,6 +51,7 @@ class YamlMap {
                                              std::to_string(max) + "], found " + std::to_string(v));
     return static_cast<int>(v);
   }
+  bool has(const std::string& key) const { return static_cast<bool>(node_[key]); }
   Time seconds(const std::string& key) const { return parseSeconds(text(key), file_, record(get(key), key)); }
   std::vector<double> numbers(const std::string& key) const {
     const YAML::Node n = get(key);
@@ -130,6 +131,8 @@ SimSensorInfo readSensors(const YamlMap& m) {
   s.camera_channels = camera.integer("channels", 1, 3);
   if (s.camera_channels == 2) camera.failKey("channels", "expected 1 (mono8) or 3 (bgr8)");
   s.camera_exposure_s = camera.number("exposure_s");
+  // Datasets written before the key are point-sampled.
+  s.camera_pixel_samples = camera.has("pixel_samples") ? camera.integer("pixel_samples", 1, 4) : 1;
   const YamlMap imu = m.map("imu");
   s.imu_rate_hz = imu.positive("rate_hz");
   s.gyro_noise_density = imu.number("gyro_noise_density");

@@ -61,6 +61,8 @@ std::string CameraModelConfig::validate() const {
     error << "camera exposure_s must be in [0, 1 / rate_hz = " << 1.0 / rate_hz << "), got " << exposure_s;
   } else if (motion_blur_samples < 1 || motion_blur_samples > 64) {
     error << "camera motion_blur_samples must be in [1, 64], got " << motion_blur_samples;
+  } else if (pixel_samples < 1 || pixel_samples > 4) {
+    error << "camera pixel_samples must be in [1, 4], got " << pixel_samples;
   } else if (!(noise_sigma >= 0) || !std::isfinite(noise_sigma)) {
     error << "camera noise_sigma must be >= 0 and finite, got " << noise_sigma;
   } else if (!sky.allFinite() || sky.minCoeff() < 0) {
@@ -83,6 +85,21 @@ CameraRenderer::CameraRenderer(const CameraModelConfig& config) : config_(config
       }
     }
   });
+  const int n = config_.pixel_samples;
+  if (n > 1) {
+    const std::size_t per_pixel = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+    rays_area_.resize(rays_cam_.size() * per_pixel);
+    tbb::parallel_for(tbb::blocked_range<int>(0, k.height), [&](const tbb::blocked_range<int>& rows) {
+      for (int v = rows.begin(); v != rows.end(); ++v) {
+        for (int u = 0; u < k.width; ++u) {
+          Eigen::Vector3f* out = &rays_area_[(static_cast<std::size_t>(v) * width_ + u) * per_pixel];
+          for (int b = 0; b < n; ++b)
+            for (int a = 0; a < n; ++a)
+              *out++ = unproject(Eigen::Vector2d(u + (a + 0.5) / n - 0.5, v + (b + 0.5) / n - 0.5)).cast<float>();
+        }
+      }
+    });
+  }
   // The field of view the image covers, in |xn|^2, from the rays through the image border (with margin).
   double max_r2 = 0;
   for (const Eigen::Vector3f& r : rays_cam_) {

@@ -45,6 +45,11 @@ struct CameraModelConfig {
   double exposure_s = 0.01;            // [s] ideal camera's exposure (motion blur); < 1 / rate_hz. The real camera's
                                        // exposure comes from its auto exposure (exposure below)
   int motion_blur_samples = 1;         // 1 = no blur; N sub-frames averaged over the exposure (<= 64)
+  // Rays per pixel side: 1 samples the scene at the pixel's centre, so texture and edges finer than a pixel alias
+  // and shimmer as the view moves sub-pixel, which LK reads as motion: tracks on point-sampled frames drift ~0.14
+  // px a frame (bench/RESULTS.md). N averages N x N rays spread evenly over the pixel's area, as a sensor pixel
+  // integrates the light falling on it (a box filter; costs N^2 rays a pixel and sub-frame). 1 ... 4.
+  int pixel_samples = 1;
   double noise_sigma = 2.0;            // [grey levels of 255], Gaussian read noise
   bool color = false;                  // false: mono8 (as most VIO cameras); true: bgr8
   Eigen::Vector3f sky = Eigen::Vector3f(0.7f, 0.8f, 0.95f);  // linear RGB where no surface is hit (outdoors)
@@ -114,6 +119,9 @@ class CameraRenderer {
   std::size_t width_ = 0;
   double max_r2_ = 0;                      // largest |xn|^2 of any pixel, with margin (limits project())
   std::vector<Eigen::Vector3f> rays_cam_;  // unit ray per pixel, row-major, camera frame (z forward)
+  // pixel_samples > 1: pixel_samples^2 unit rays per pixel, pixel after pixel (row-major), through the pixel's
+  // sub-pixel centres (u + (a + 0.5) / N - 0.5, v + (b + 0.5) / N - 0.5)
+  std::vector<Eigen::Vector3f> rays_area_;
 };
 
 }  // namespace drover::sim

@@ -1,6 +1,7 @@
-// CameraRenderer::renderRadiance: one ray per pixel (and per motion-blur sub-frame) into the world, texture * light *
-// Lambert shading. CameraRenderer::render: the ideal camera on top of it, counter-based Gaussian read noise and 8-bit
-// quantisation (linear, no gamma curve). The sensor with exposure and gain is camera_exposure.cpp.
+// CameraRenderer::renderRadiance: one ray per pixel, or pixel_samples^2 over its area (and per motion-blur sub-frame)
+// into the world, texture * light * Lambert shading. CameraRenderer::render: the ideal camera on top of it,
+// counter-based Gaussian read noise and 8-bit quantisation (linear, no gamma curve). The sensor with exposure and
+// gain is camera_exposure.cpp.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -52,14 +53,24 @@ void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& 
                                const Illumination& illumination, int v, float* row, bool textureless) const {
   const int width = config_.intrinsics.width;
   const float inv_samples = 1.0f / static_cast<float>(subframes.size());
+  const auto per_pixel = static_cast<std::size_t>(config_.pixel_samples * config_.pixel_samples);
+  const float inv_area = 1.0f / static_cast<float>(per_pixel);
   for (int u = 0; u < width; ++u) {
     const std::uint64_t pixel = static_cast<std::uint64_t>(v) * width_ + static_cast<std::uint64_t>(u);
-    const Eigen::Vector3d ray_cam = rays_cam_[pixel].cast<double>();
     Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
-    for (const SubFrame& s : subframes) {
-      rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless);
+    if (rays_area_.empty()) {
+      const Eigen::Vector3d ray_cam = rays_cam_[pixel].cast<double>();
+      for (const SubFrame& s : subframes)
+        rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless);
+      rgb *= inv_samples * 255.0f;
+    } else {
+      for (std::size_t k = pixel * per_pixel; k < (pixel + 1) * per_pixel; ++k) {
+        const Eigen::Vector3d ray_cam = rays_area_[k].cast<double>();
+        for (const SubFrame& s : subframes)
+          rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless);
+      }
+      rgb *= inv_samples * inv_area * 255.0f;
     }
-    rgb *= inv_samples * 255.0f;
     if (!config_.color) {
       row[u] = 0.299f * rgb.x() + 0.587f * rgb.y() + 0.114f * rgb.z();
     } else {

@@ -255,6 +255,7 @@ io::SimDatasetDescription Simulator::datasetDescription() const {
   s.camera_rate_hz = config_.camera.rate_hz;
   s.camera_channels = config_.camera.color ? 3 : 1;
   s.camera_exposure_s = config_.camera.exposure_s;
+  s.camera_pixel_samples = config_.camera.pixel_samples;
   const ImuModelConfig& imu = config_.imu;
   s.imu_rate_hz = imu.rate_hz;
   // The densities of the data as generated: zero when the model's noise is off.

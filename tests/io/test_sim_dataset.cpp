@@ -383,12 +383,13 @@ TEST(SimDatasetReader, RingBeyondTheLidarsRingsIsNamed) {
 TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
   TempDir tmp;
   test::writeText(tmp / "a.yaml", "dataset:\n  load_lidar: true\nsim:\n  lidar_model: hdl64\n  camera_rate_hz: 20\n"
-                                  "  camera_color: true\n  camera_time_offset: -0.002\n");
+                                  "  camera_color: true\n  camera_time_offset: -0.002\n  camera_pixel_samples: 2\n");
   const SimConfigSettings s = loadSimConfigSettings((tmp / "a.yaml").string());
   EXPECT_EQ(s.lidar_model, "hdl64");
   EXPECT_EQ(s.camera_rate_hz, 20.0);
   EXPECT_EQ(s.camera_color, true);
   EXPECT_EQ(s.camera_time_offset_s, -0.002);
+  EXPECT_EQ(s.camera_pixel_samples, 2);
   EXPECT_FALSE(s.imu_rate_hz.has_value());
   test::writeText(tmp / "b.yaml", "sim:\n  lidar_modle: vlp32\n");
   expectIoError([&] { loadSimConfigSettings((tmp / "b.yaml").string()); }, {"b.yaml", "line 2", "sim.lidar_modle"});
@@ -408,6 +409,7 @@ TEST(SimConfigSettings, RatesAndOffsetsShareTheOptionsRanges) {
   error("ground_truth_rate_hz: 50", {"[100, 1000] Hz"});
   error("lidar_time_offset: 2", {"key 'sim.lidar_time_offset'", "[-1, 1] s"});
   error("lidar_columns: 0", {"key 'sim.lidar_columns'", "[1, 100000]"});
+  error("camera_pixel_samples: 5", {"key 'sim.camera_pixel_samples'", "[1, 4]"});
 }
 
 TEST(SimConfigSettings, FarmSimConfigIsAValidPlatformAndSimConfig) {

@@ -157,6 +157,8 @@ TEST(CameraModel, ValidateNamesTheBadValueAndTheRendererRefusesIt) {
   EXPECT_NE(errorOf([](auto& c) { c.intrinsics.distortion = DistortionModel::kEquidistant; }).find("equidistant"),
             std::string::npos);
   EXPECT_NE(errorOf([](auto& c) { c.noise_sigma = -1; }).find("noise_sigma"), std::string::npos);
+  EXPECT_NE(errorOf([](auto& c) { c.pixel_samples = 0; }).find("pixel_samples"), std::string::npos);
+  EXPECT_NE(errorOf([](auto& c) { c.pixel_samples = 5; }).find("pixel_samples"), std::string::npos);
   CameraModelConfig config;
   config.intrinsics.fx = 0;
   EXPECT_THROW(CameraRenderer{config}, std::invalid_argument);
@@ -294,6 +296,40 @@ TEST(CameraRenderer, WhiteBoxAppearsWhereProjectPredictsAndTheRestIsSky) {
       }
     }
   }
+}
+
+// A sensor pixel integrates the light over its area: a pixel that a box's vertical edge crosses reads the share of
+// its area on the box. With 4 x 4 rays a pixel that share is known to 1/8 (the rays sit at 1/8, 3/8, ... of the
+// pixel); with one ray the pixel is all box or all sky (the first test above), and the edge aliases.
+TEST(CameraRenderer, WithFourByFourRaysAPixelOnABoxEdgeReadsTheShareOfItsAreaOnTheBox) {
+  CameraModelConfig config = noiselessConfig();
+  config.intrinsics.distortion = DistortionModel::kNone;  // straight edges: u of the edge is one number
+  config.intrinsics.distortion_coeffs.clear();
+  config.sky = Eigen::Vector3f::Constant(0.2f);
+  config.pixel_samples = 4;
+  const CameraRenderer camera(config);
+  // Front face at x = 4.5 m, y in [-0.9, 0.3]: its left edge (y = 0.3, x_cam = -0.3) at u = cx - fx * 0.3 / 4.5.
+  Box box;
+  box.T_world_box.translation() = Eigen::Vector3d(5.0, -0.3, 0.2);
+  box.half_extents = Eigen::Vector3d(0.5, 0.6, 0.4);
+  World world;
+  world.addBox(box, whiteMaterial(1.0f));
+  world.build();
+  const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kSecond / 2, 1, 0);
+  const double u_edge = config.intrinsics.cx - config.intrinsics.fx * 0.3 / 4.5;
+  const double box_grey = 255.0 * lambertFactor(Eigen::Vector3d(-1, 0, 0)), sky_grey = 255.0 * 0.2;
+  ASSERT_GT(box_grey, sky_grey + 50);
+  int partial = 0;
+  for (int v = 230; v < 250; ++v) {  // rows through the face's middle (v of its centre ~ cy + fy * -0.2 / 4.5)
+    for (int u = static_cast<int>(std::floor(u_edge)) - 2; u <= static_cast<int>(std::floor(u_edge)) + 2; ++u) {
+      const double share = std::clamp(u + 0.5 - u_edge, 0.0, 1.0);
+      const double grey = frame.image.data[static_cast<std::size_t>(v) * 640 + u];
+      EXPECT_NEAR((grey - sky_grey) / (box_grey - sky_grey), share, 1.0 / 8 + 1.0 / (box_grey - sky_grey))
+          << "u " << u << ", v " << v << ", edge at u " << u_edge;
+      partial += grey > sky_grey + 1 && grey < box_grey - 1;
+    }
+  }
+  EXPECT_EQ(partial, 20) << "one pixel a row lies partly on the box";
 }
 
 TEST(CameraRenderer, TexturedWallHasGradientsWhileAWhiteWallShowsOnlyNoise) {
