@@ -9,6 +9,7 @@
 
 #include "sim/camera_exposure.hpp"
 #include "sim/camera_stream.hpp"
+#include "support/camera_scene.hpp"
 
 using namespace drover;
 using namespace drover::sim;
@@ -18,14 +19,7 @@ namespace {
 constexpr Time kSecond = kNanosPerSecond;
 constexpr float kAlbedo = 0.6f;
 
-// Camera z forward, x right, y down, looking along body (= world) x.
-Eigen::Isometry3d forwardCamera() {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear().col(0) = Eigen::Vector3d(0, -1, 0);
-  T.linear().col(1) = Eigen::Vector3d(0, 0, -1);
-  T.linear().col(2) = Eigen::Vector3d(1, 0, 0);
-  return T;
-}
+using drover::test::forwardCamera;
 
 // At the origin over [0, 10] s.
 SplineTrajectory stillTrajectory() {

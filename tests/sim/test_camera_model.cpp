@@ -7,24 +7,17 @@
 #include <stdexcept>
 
 #include "sim/camera_model.hpp"
+#include "support/camera_scene.hpp"
 
 using namespace drover;
 using namespace drover::sim;
 
 namespace {
 
-constexpr Time kSecond = kNanosPerSecond;
+using drover::test::forwardCamera;
+using drover::test::wallWorld;
 
-// Body frame x forward, y left, z up; camera z forward, x right, y down, at the body origin.
-Eigen::Isometry3d forwardCamera() {
-  Eigen::Matrix3d R_body_cam;
-  R_body_cam.col(0) = Eigen::Vector3d(0, -1, 0);
-  R_body_cam.col(1) = Eigen::Vector3d(0, 0, -1);
-  R_body_cam.col(2) = Eigen::Vector3d(1, 0, 0);
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = R_body_cam;
-  return T;
-}
+constexpr Time kSecond = kNanosPerSecond;
 
 // Samples every 0.1 s over [0, 1] s at the origin, yaw = yaw_rate * (t - 0.5 s) (looking along +x at 0.5 s).
 SplineTrajectory yawingTrajectory(double yaw_rate) {
@@ -40,20 +33,6 @@ SplineTrajectory yawingTrajectory(double yaw_rate) {
 
 SplineTrajectory stationaryTrajectory() { return yawingTrajectory(0.0); }
 
-// A wall in the plane x = distance facing the origin (normal -x), 40 m x 40 m.
-World wallWorld(double distance, const Material& material) {
-  Rectangle wall;
-  wall.T_world_rect.linear().col(0) = Eigen::Vector3d(0, -1, 0);
-  wall.T_world_rect.linear().col(1) = Eigen::Vector3d(0, 0, 1);
-  wall.T_world_rect.linear().col(2) = Eigen::Vector3d(-1, 0, 0);
-  wall.T_world_rect.translation() = Eigen::Vector3d(distance, 0, 0);
-  wall.half_size = Eigen::Vector2d(20, 20);
-  World world;
-  world.addRectangle(wall, material);
-  world.build();
-  return world;
-}
-
 Material whiteMaterial(float albedo) {
   Material m;
   m.texture = Texture::kWhite;
@@ -67,6 +46,17 @@ Material noiseMaterial() {
   m.scale = 0.1f;
   m.seed = 7;
   return m;
+}
+
+// A white box centred 5 m ahead; its front face (normal -x) lies at x = 4.5, y in [-0.9, 0.3], z in [-0.2, 0.6].
+World whiteBoxAhead() {
+  Box box;
+  box.T_world_box.translation() = Eigen::Vector3d(5.0, -0.3, 0.2);
+  box.half_extents = Eigen::Vector3d(0.5, 0.6, 0.4);
+  World world;
+  world.addBox(box, whiteMaterial(1.0f));
+  world.build();
+  return world;
 }
 
 CameraModelConfig noiselessConfig() {
@@ -240,13 +230,7 @@ TEST(CameraRenderer, WhiteBoxAppearsWhereProjectPredictsAndTheRestIsSky) {
   CameraModelConfig config = noiselessConfig();
   config.sky = Eigen::Vector3f::Constant(0.2f);
   const CameraRenderer camera(config);
-  // Box centred 5 m ahead; its front face (normal -x) lies at x = 4.5, y in [-0.9, 0.3], z in [-0.2, 0.6].
-  Box box;
-  box.T_world_box.translation() = Eigen::Vector3d(5.0, -0.3, 0.2);
-  box.half_extents = Eigen::Vector3d(0.5, 0.6, 0.4);
-  World world;
-  world.addBox(box, whiteMaterial(1.0f));
-  world.build();
+  const World world = whiteBoxAhead();
   const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kSecond / 2, 1, 0);
   EXPECT_EQ(frame.t, kSecond / 2);
   EXPECT_EQ(frame.camera_id, 0);
@@ -309,12 +293,7 @@ TEST(CameraRenderer, WithFourByFourRaysAPixelOnABoxEdgeReadsTheShareOfItsAreaOnT
   config.pixel_samples = 4;
   const CameraRenderer camera(config);
   // Front face at x = 4.5 m, y in [-0.9, 0.3]: its left edge (y = 0.3, x_cam = -0.3) at u = cx - fx * 0.3 / 4.5.
-  Box box;
-  box.T_world_box.translation() = Eigen::Vector3d(5.0, -0.3, 0.2);
-  box.half_extents = Eigen::Vector3d(0.5, 0.6, 0.4);
-  World world;
-  world.addBox(box, whiteMaterial(1.0f));
-  world.build();
+  const World world = whiteBoxAhead();
   const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kSecond / 2, 1, 0);
   const double u_edge = config.intrinsics.cx - config.intrinsics.fx * 0.3 / 4.5;
   const double box_grey = 255.0 * lambertFactor(Eigen::Vector3d(-1, 0, 0)), sky_grey = 255.0 * 0.2;

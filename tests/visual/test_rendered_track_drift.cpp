@@ -14,6 +14,7 @@
 
 #include "sim/camera_model.hpp"
 #include "sim/world.hpp"
+#include "support/camera_scene.hpp"
 #include "visual/feature_tracker.hpp"
 
 namespace drover::sim {
@@ -25,19 +26,10 @@ constexpr int kFrames = 16;            // 15 chained steps
 constexpr double kFrameS = 1.0 / 15;   // [s]
 
 World brickWall() {
-  Rectangle wall;
-  wall.T_world_rect.linear().col(0) = Eigen::Vector3d(0, -1, 0);
-  wall.T_world_rect.linear().col(1) = Eigen::Vector3d(0, 0, 1);
-  wall.T_world_rect.linear().col(2) = Eigen::Vector3d(-1, 0, 0);
-  wall.T_world_rect.translation() = Eigen::Vector3d(kWallDistance, 0, 0);
-  wall.half_size = Eigen::Vector2d(30, 30);
   Material brick;
   brick.texture = Texture::kBrick;
   brick.albedo = Eigen::Vector3f(0.7f, 0.4f, 0.3f);
-  World world;
-  world.addRectangle(wall, brick);
-  world.build();
-  return world;
+  return test::wallWorld(kWallDistance, brick, 30);
 }
 
 // Body x forward, y left, z up; the camera looks along x. The body slides to its right (-y) so that the wall's image
@@ -54,14 +46,6 @@ SplineTrajectory slidingTrajectory(double fx) {
   return SplineTrajectory(samples);
 }
 
-Eigen::Isometry3d forwardCamera() {
-  Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear().col(0) = Eigen::Vector3d(0, -1, 0);
-  T.linear().col(1) = Eigen::Vector3d(0, 0, -1);
-  T.linear().col(2) = Eigen::Vector3d(1, 0, 0);
-  return T;
-}
-
 // Median distance [px] after 15 chained LK steps between each track and where the wall's motion puts it.
 double medianDriftPx(int pixel_samples) {
   CameraModelConfig config;
@@ -75,7 +59,7 @@ double medianDriftPx(int pixel_samples) {
   std::vector<cv::Mat> frames;
   for (int k = 0; k < kFrames; ++k) {
     const CameraFrame f =
-        camera.render(world, trajectory, forwardCamera(), {}, fromSeconds(0.5 + k * kFrameS), 1, k);
+        camera.render(world, trajectory, test::forwardCamera(), {}, fromSeconds(0.5 + k * kFrameS), 1, k);
     frames.push_back(cv::Mat(f.image.height, f.image.width, CV_8UC1, const_cast<std::uint8_t*>(f.image.data.data()))
                          .clone());
   }
