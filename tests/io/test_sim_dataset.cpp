@@ -36,6 +36,7 @@ SimDatasetDescription description() {
   k.distortion = DistortionModel::kRadialTangential;
   k.distortion_coeffs = {-0.1, 0.01, 1e-4, -2e-4};
   d.sensors.gyro_noise_density = 1.7e-4;
+  d.sensors.camera_pixel_samples = 3;
   d.scenario.name = "hand-made";
   d.scenario.seed = 42;
   d.scenario.duration_s = 1.5;
@@ -188,6 +189,7 @@ TEST(SimDataset, CalibrationGroundTruthAndScenarioReadBack) {
   EXPECT_EQ(r.scenario.segments[1].end, 900);
   EXPECT_EQ(r.sensors.gyro_noise_density, 1.7e-4);
   EXPECT_EQ(r.sensors.lidar_model, "vlp16");
+  EXPECT_EQ(r.sensors.camera_pixel_samples, 3);
   EXPECT_NE(reader->describe().find("hand-made"), std::string::npos);
 }
 
