@@ -286,6 +286,13 @@ TEST(SimDatasetReader, MissingCalibrationKeyIsNamed) {
   expectIoError([&] { openSimDataset(dir2.string(), {}); }, {"sensors.lidar.rings", "missing"});
 }
 
+TEST(SimDatasetReader, CameraPixelSamplesOutOfRangeIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "calibration.yaml", "    pixel_samples: 3", "    pixel_samples: 9");
+  expectIoError([&] { openSimDataset(dir.string(), {}); }, {"calibration.yaml", "sensors.camera.pixel_samples", "[1, 4]"});
+}
+
 TEST(SimDatasetReader, ScanFileSizeNotAMultipleOfTheRecordIsNamed) {
   TempDir tmp;
   const fs::path dir = writeDataset(tmp);
