@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <stdexcept>
 
 #include "io/visual/visual_config_io.hpp"
@@ -61,14 +60,9 @@ Json frameLine(const vio::VisFrame& f) {
 }  // namespace
 
 VisSetup loadVisSetup(const std::string& config_path, const MethodChoice& method, const std::string& base_dir) {
-  io::VisualConfig visual = config_path.empty() ? io::VisualConfig{} : io::loadVisualConfig(config_path);
-  std::string& weights = visual.detector.superpoint.weights;
-  if (!base_dir.empty() && !weights.empty() && std::filesystem::path(weights).is_relative()) {
-    std::error_code ec;
-    const std::filesystem::path there = std::filesystem::path(base_dir) / weights;
-    if (!std::filesystem::is_regular_file(weights, ec) && std::filesystem::is_regular_file(there, ec))
-      weights = there.lexically_normal().string();
-  }
+  const std::vector<std::string> also_look_in = base_dir.empty() ? std::vector<std::string>{}
+                                                                 : std::vector<std::string>{base_dir};
+  io::VisualConfig visual = config_path.empty() ? io::VisualConfig{} : io::loadVisualConfig(config_path, also_look_in);
   VisSetup setup;
   setup.config.vio = config_path.empty() ? vio::VioConfig{} : io::loadVioConfig(config_path);
   method.apply(visual, setup.config.vio);

@@ -255,6 +255,20 @@ TEST(VisualConfigReader, RelativeWeightsAreTheWorkingDirectorysElseTheOnesBeside
             relative);
 }
 
+TEST(VisualConfigReader, RelativeWeightsFoundNeitherHereNorBesideTheConfigAreLookedForInTheCallersFolders) {
+  test::TempDir dir, repo, other;
+  test::writeText(dir / "visual.yaml", "visual:\n  detector:\n    superpoint:\n      weights: models/sp.onnx\n");
+  test::writeText(repo / "models" / "sp.onnx", "x");
+  const std::string config = (dir / "visual.yaml").string();
+  EXPECT_EQ(loadVisualConfig(config, {other.path().string(), repo.path().string()}).detector.superpoint.weights,
+            (repo / "models" / "sp.onnx").lexically_normal().string());
+  EXPECT_EQ(loadVisualConfig(config, {other.path().string()}).detector.superpoint.weights, "models/sp.onnx");
+  // The file beside the config comes first.
+  test::writeText(dir / "models" / "sp.onnx", "y");
+  EXPECT_EQ(loadVisualConfig(config, {repo.path().string()}).detector.superpoint.weights,
+            (dir / "models" / "sp.onnx").lexically_normal().string());
+}
+
 TEST(VisualConfigReader, MissingFileIsAnIoError) {
   EXPECT_THROW(loadVisualConfig("/nonexistent/config.yaml"), IoError);
 }

@@ -103,20 +103,26 @@ visual::ClaheMode parseClahe(const std::string& name) {  // already checked by b
 
 // A relative weights path is the working directory's (the shipped configs' ../shared/... is the repository root's).
 // Where nothing is there but the file sits beside the config, that is the one meant: a platform file kept with its
-// own weights then works from any working directory. Otherwise the path is left as written, for the detector's
-// error to name.
-std::string resolveBesideConfig(const std::string& yaml_path, const std::string& path) {
+// own weights then works from any working directory; after it the caller's folders. Otherwise the path is left as
+// written, for the detector's error to name.
+std::string resolveWeights(const std::string& yaml_path, const std::string& path,
+                           const std::vector<std::string>& also_look_in) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path p(path);
   if (path.empty() || p.is_absolute() || fs::exists(p, ec)) return path;
-  const fs::path beside = fs::path(yaml_path).parent_path() / p;
-  return fs::is_regular_file(beside, ec) ? beside.lexically_normal().string() : path;
+  std::vector<fs::path> folders{fs::path(yaml_path).parent_path()};
+  folders.insert(folders.end(), also_look_in.begin(), also_look_in.end());
+  for (const fs::path& folder : folders) {
+    const fs::path there = folder / p;
+    if (fs::is_regular_file(there, ec)) return there.lexically_normal().string();
+  }
+  return path;
 }
 
 }  // namespace
 
-VisualConfig loadVisualConfig(const std::string& yaml_path) {
+VisualConfig loadVisualConfig(const std::string& yaml_path, const std::vector<std::string>& also_look_in) {
   const YAML::Node root = loadConfigRoot(yaml_path);
   VisualConfig c;
   if (root.IsNull()) return c;
@@ -130,7 +136,7 @@ VisualConfig loadVisualConfig(const std::string& yaml_path) {
   top.apply(visual);
   c.detector.type = visual::parseDetectorType(type);  // already checked by bindChoice
   c.tracker.clahe = parseClahe(clahe);
-  c.detector.superpoint.weights = resolveBesideConfig(yaml_path, c.detector.superpoint.weights);
+  c.detector.superpoint.weights = resolveWeights(yaml_path, c.detector.superpoint.weights, also_look_in);
   // Every detector's settings are checked, not only the chosen one's: a typo must not wait for a switch.
   const YAML::Node det = visual && visual.IsMap() ? visual["detector"] : YAML::Node();
   auto sub = [&](const char* key) { return det && det.IsMap() ? det[key] : YAML::Node(); };

@@ -22,6 +22,7 @@
 // One bind function per sub-section in visual_config_io.cpp, one field in VisualConfig.
 // Lives in its own library (drover_io_visual) so that the readers do not depend on the visual module.
 #include <string>
+#include <vector>
 
 #include "visual/depth_association.hpp"
 #include "visual/detector_factory.hpp"
@@ -37,6 +38,8 @@ struct VisualConfig {
 
 // Throws IoError (file, line, key) for a missing file, invalid YAML, unknown key or bad value, and when a
 // sub-section fails its Config::validate() (naming the file, the sub-section's line and the section).
-VisualConfig loadVisualConfig(const std::string& yaml_path);
+// A relative SuperPoint weights path is the working directory's, else the one beside the config file, else the first
+// of `also_look_in` that holds it (drover_ros: the repository, since a node's working directory is ~/.ros).
+VisualConfig loadVisualConfig(const std::string& yaml_path, const std::vector<std::string>& also_look_in = {});
 
 }  // namespace drover::io
