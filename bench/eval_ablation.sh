@@ -16,6 +16,7 @@
 # and ~14 GB with its camera). Runs are kept in $DROVER_OUT/ablation/<course>/<row>.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/sim_cache.sh
 BUILD_DIR=${DROVER_BUILD_DIR:-build}
 OUT_ROOT=${DROVER_OUT:-out}
 DROVER="$BUILD_DIR/apps/drover/drover"
@@ -44,7 +45,7 @@ for c in "${COURSES[@]}"; do
   scenario=$c seed=1
   case "$c" in farm-*) scenario=farm seed=${c#farm-} ;; esac
   data="$OUT_ROOT/sim/$c-cam"
-  [ -f "$data/scenario.json" ] ||
+  course_is_current "$data" "$CONFIG" ||
     "$DROVER" sim --scenario "$scenario" --seed "$seed" --config "$CONFIG" --out "$data" --force -q
   mkdir -p "bench/out/ablation/$c" "$OUT_ROOT/ablation/$c"
   for row in "${ROWS[@]}"; do

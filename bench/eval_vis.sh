@@ -9,6 +9,7 @@
 #   env: SEEDS="1 2 3"  DETECTORS="shi-tomasi orb superpoint"  DEPTH_MODES="fixed factor off"  DURATION=40
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/sim_cache.sh
 BUILD_DIR=${DROVER_BUILD_DIR:-build}
 OUT_ROOT=${DROVER_OUT:-out}
 DROVER="$BUILD_DIR/apps/drover/drover"
@@ -54,7 +55,7 @@ PY
 for seed in $SEEDS; do
   for c in "${COURSES[@]}"; do
     data="$OUT_ROOT/sim/vis_${c}_s$seed"
-    [ -f "$data/scenario.json" ] || "$DROVER" sim --scenario "$c" --seed "$seed" --duration "$DURATION" \
+    course_is_current "$data" config/farm_sim.yaml || "$DROVER" sim --scenario "$c" --seed "$seed" --duration "$DURATION" \
       --config config/farm_sim.yaml --out "$data" --force -q
     for d in $DETECTORS; do run "$data" "${c}_s${seed}_alone_$d" "$(config "$d" fixed)" --no-lidar; done
     for m in $DEPTH_MODES; do run "$data" "${c}_s${seed}_lis_$m" "$(config shi-tomasi "$m")"; done

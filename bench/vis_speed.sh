@@ -10,6 +10,7 @@
 #   DROVER=/path/to/other/drover bash bench/vis_speed.sh       # another binary on the same data (before/after)
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/sim_cache.sh
 DROVER=${DROVER:-build/apps/drover/drover}
 COURSE=${COURSE:-farm}
 SEED=${SEED:-1}
@@ -19,7 +20,7 @@ DETECTORS=${DETECTORS:-shi-tomasi superpoint}
 OUT=${OUT:-bench/out/vis_speed}
 DATA=${DATA:-$OUT/sim_${COURSE}_${SEED}_${DURATION}}
 mkdir -p "$OUT"
-[ -f "$DATA/scenario.json" ] || "$DROVER" sim --scenario "$COURSE" --seed "$SEED" --duration "$DURATION" \
+course_is_current "$DATA" config/farm_sim.yaml || "$DROVER" sim --scenario "$COURSE" --seed "$SEED" --duration "$DURATION" \
   --config config/farm_sim.yaml --out "$DATA" --force -q
 echo "| detector | run | wall [s] | x real time | track | solve | marginalise | estimator | frames estimated | resets | VIS APE rmse [m] |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"

@@ -19,8 +19,10 @@ DROVER="$BUILD_DIR/apps/drover/drover"
 SIM_OUT="$OUT_ROOT/sim"
 FARM="$SIM_OUT/farm"
 mkdir -p "$SIM_OUT"
-# (a cached course without camera frames, from an older run.sh, is generated again)
-if [ ! -f "$FARM/calibration.yaml" ] || [ "$(wc -l < "$FARM/camera/timestamps.csv")" -le 1 ]; then
+# (a cached course without camera frames, or rendered with other rays a pixel than the config's, is generated again)
+# shellcheck source=scripts/sim_cache.sh
+. scripts/sim_cache.sh
+if ! course_is_current "$FARM" config/farm_sim.yaml || [ "$(wc -l < "$FARM/camera/timestamps.csv")" -le 1 ]; then
   "$DROVER" sim --scenario farm --seed 1 --config config/farm_sim.yaml --out "$FARM" --force
 fi
 DROVER_PRESET=(--preset drover)
