@@ -77,9 +77,11 @@ void BM_SimLidarSweepVlp16(benchmark::State& state) {
 }
 BENCHMARK(BM_SimLidarSweepVlp16)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// Arg: rays per pixel side (sim.camera_pixel_samples; the farm configs ship 2).
 void BM_SimCameraFrame640x480(benchmark::State& state) {
   const sim::Scenario& s = farm();
-  const sim::SimulatorConfig c = sim::SimulatorConfig::defaults();
+  sim::SimulatorConfig c = sim::SimulatorConfig::defaults();
+  c.camera.pixel_samples = static_cast<int>(state.range(0));
   const sim::CameraRenderer renderer(c.camera);
   std::uint64_t k = 0;
   for (auto _ : state) {
@@ -89,7 +91,7 @@ void BM_SimCameraFrame640x480(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_SimCameraFrame640x480)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SimCameraFrame640x480)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_SimImu60s(benchmark::State& state) {
   const sim::Scenario& s = farm();
