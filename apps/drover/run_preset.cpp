@@ -46,6 +46,12 @@ void withoutGates(pipeline::VisualMotionConfig& f) {
 // Shi-Tomasi's tracks keep the platform's value: at 2e-3 the farm with Shi-Tomasi went 0.167 -> 0.182 m.
 constexpr double kSuperPointMinEigenvalue = 2e-3;
 
+// The drover preset's vio.max_keyframe_interval_s where the platform sets none: a window without parallax (far
+// features only, the white walls) still takes a keyframe every ~0.5 s, so that the newest frame never hangs off a
+// keyframe by a preintegration of tens of seconds (vio/vio_config.hpp). A moving VIS makes 7-10 keyframes a second
+// by parallax, so this acts only where it stalls; the LIS's stall gate counts parallax keyframes alone.
+constexpr double kKeyframeInterval = 0.5;  // [s]
+
 }  // namespace
 
 void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
@@ -95,6 +101,7 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
   if (preset == Preset::kDrover) {
     visual.detector.type = visual::DetectorType::kSuperPoint;
     vio.depth_mode = vio::DepthMode::kFactor;
+    if (vio.max_keyframe_interval_s <= 0) vio.max_keyframe_interval_s = kKeyframeInterval;
   } else if (preset == Preset::kLviSam) {
     // LVI-SAM params_camera.yaml: max_cnt 150, min_dist 20, F_threshold 1.0, keyframe_parallax 10, window 10.
     visual.detector.type = visual::DetectorType::kShiTomasi;
@@ -102,6 +109,7 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
     visual.tracker.min_distance = 20;
     visual.tracker.ransac_threshold_px = 1.0;
     vio.min_parallax_px = 10;
+    vio.max_keyframe_interval_s = 0;  // VINS-Mono's keyframes come by parallax (or few tracks) alone
     vio.window = 10;
     vio.depth_mode = vio::DepthMode::kFixed;
     // Its feature_tracker calls cv::calcOpticalFlowPyrLK with the default minEigThreshold.
@@ -112,7 +120,7 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
 std::vector<std::string> partNames() {
   return {"vo-factor",     "vis-guess", "vis-gates",          "visual-yaw-prior", "scan-context",
           "radius-search", "four-dof",  "loop-fitness-sigma", "vis-carried-sigma", "depth-factor",
-          "superpoint",    "lk-min-eigenvalue"};
+          "superpoint",    "lk-min-eigenvalue", "keyframe-interval"};
 }
 
 void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
@@ -133,6 +141,7 @@ void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
 void removePart(const std::string& part, io::VisualConfig& visual, vio::VioConfig& vio) {
   if (part == "depth-factor") vio.depth_mode = vio::DepthMode::kFixed;
   if (part == "superpoint") visual.detector.type = visual::DetectorType::kShiTomasi;
+  if (part == "keyframe-interval") vio.max_keyframe_interval_s = 0;
 }
 
 std::string MethodChoice::describe() const {

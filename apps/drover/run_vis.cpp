@@ -34,6 +34,7 @@ Json frameLine(const vio::VisFrame& f) {
   Json line = {{"t", toSeconds(r.t)},
                {"initialized", r.initialized},
                {"keyframe", r.keyframe},
+               {"keyframe_by_time", r.keyframe_by_time},
                {"detected", f.detected},
                {"tracked", f.front_tracked},
                {"features", r.features},
@@ -242,6 +243,7 @@ void VisFrameSums::add(const vio::VisFrame& f) {
   const vio::FrameResult& r = f.estimate;
   ++frames;
   keyframes += r.keyframe ? 1 : 0;
+  keyframes_by_time += r.keyframe_by_time ? 1 : 0;
   detected += f.detected ? 1 : 0;
   tracked += f.front_tracked, with_depth += r.with_lidar_depth, share_three += f.share_three;
   on_ground += r.on_ground;
@@ -279,6 +281,7 @@ Json RunVis::report() const {
   const VisFrameSums& m = sums_;
   const double d = m.frames > 0 ? static_cast<double>(m.frames) : 1.0;
   j["keyframes"] = m.keyframes;
+  j["keyframes_by_time"] = m.keyframes_by_time;  // of them, made by vio.max_keyframe_interval_s alone
   j["frames_detected"] = m.detected;
   j["mean"] = {{"tracked", m.tracked / d},
                {"features_with_lidar_depth", m.with_depth / d},

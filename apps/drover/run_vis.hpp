@@ -21,7 +21,7 @@ namespace drover::cli {
 
 // Sums over the recorded frames, for report.json's means.
 struct VisFrameSums {
-  std::size_t frames = 0, keyframes = 0, detected = 0;
+  std::size_t frames = 0, keyframes = 0, keyframes_by_time = 0, detected = 0;
   double tracked = 0, with_depth = 0, on_ground = 0, share_three = 0;
   vio::VisStageMs ms;
   void add(const vio::VisFrame& f);

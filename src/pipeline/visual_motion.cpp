@@ -40,7 +40,7 @@ std::optional<VisualState> VisualStateStream::onFrame(const vio::FrameResult& r)
     keyframe_interval_ = 0;
   }
   if (!r.initialized) return std::nullopt;
-  if (r.keyframe) {
+  if (r.keyframe && !r.keyframe_by_time) {  // the stall gate asks when the VIS last saw parallax
     keyframe_interval_ = r.t - keyframe_time_;
     keyframe_time_ = r.t;
   }

@@ -99,7 +99,9 @@ struct VisualState {
   int features = 0;           // features in the frame's solve
   std::uint32_t reset_id = 0; // the VIS's (re)initialisation count: states of different IDs are not related
   Time initialized_at = 0;    // [ns] when the VIS last (re)initialised
-  Time last_keyframe_at = 0;  // [ns] the VIS's newest keyframe (its initialisation when none since)
+  // [ns] the VIS's newest keyframe made by parallax (its initialisation when none since); keyframes made by
+  // vio.max_keyframe_interval_s alone do not count: they keep a stalled window conditioned, not moving.
+  Time last_keyframe_at = 0;
   Time keyframe_interval = 0; // [ns] from the keyframe before it (0 when none)
   // Of the pose relative to the previous frame's state (vio::FrameResult::relative_covariance), when computed.
   std::optional<Eigen::Matrix<double, 6, 6>> relative_covariance;

@@ -148,8 +148,9 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
   const int index = static_cast<int>(frames_.size());
   const double parallax = features_.addFrame(index, features, td_[0]);
   result.tracked = features_.lastTracked();
-  const bool keyframe = index < 2 || parallax < 0 || result.tracked < config_.min_tracked_for_parallax ||
-                        parallax * config_.focal_px >= config_.min_parallax_px;
+  const bool by_parallax = index < 2 || parallax < 0 || result.tracked < config_.min_tracked_for_parallax ||
+                           parallax * config_.focal_px >= config_.min_parallax_px;
+  const bool keyframe = by_parallax || keyframeIsDue();
   if (!frames_.empty()) {
     integrate(*frame, *frames_.back());
     if (initialized_) predict(*frame, *frames_.back());
@@ -190,6 +191,7 @@ FrameResult SlidingWindowEstimator::addFrame(Time t_camera, const std::vector<Fr
   }
   last_output_ = result;
   if (static_cast<int>(frames_.size()) > config_.window) slide(keyframe, result);
+  result.keyframe_by_time = result.keyframe && !by_parallax;
   return result;
 }
 
@@ -280,6 +282,12 @@ void SlidingWindowEstimator::fillResult(FrameResult& result) const {
   result.v_world = f.velocity();
   result.bias = f.imuBias();
   result.td = td_[0];
+}
+
+bool SlidingWindowEstimator::keyframeIsDue() const {
+  const std::size_t n = frames_.size();  // before the newest frame is pushed: [n-1] is then the second-newest
+  return initialized_ && config_.max_keyframe_interval_s > 0 && n >= 2 &&
+         frames_[n - 1]->t - frames_[n - 2]->t >= fromSeconds(config_.max_keyframe_interval_s);
 }
 
 // One frame leaves: the oldest when the second-newest is a keyframe, else the second-newest (VINS slideWindow).

@@ -56,6 +56,7 @@ struct FrameResult {
                                     // its pose is not continuous with the previous frame's (like an initialisation)
   std::string event;                // why initialisation waits, how it succeeded, or why the window was reset
   bool keyframe = false;            // the second-newest frame was kept (the oldest was marginalised)
+  bool keyframe_by_time = false;    // ... by vio.max_keyframe_interval_s alone (too little parallax for one)
   int tracked = 0;                  // features of this frame already in the window
   int features = 0;                 // features used in the solve
   int with_lidar_depth = 0;         // of those, anchored on a lidar depth
@@ -117,6 +118,8 @@ class SlidingWindowEstimator {
   std::string failure(const FrameResult& result) const;
   // Without a LIS, too few tracked features for up to vio.coast_max_s do not clear the window: sets result.coasting.
   void checkCoasting(FrameResult& result, bool has_seed);
+  // vio.max_keyframe_interval_s: the second-newest frame came that long after the keyframe before it.
+  bool keyframeIsDue() const;
   void slide(bool keyframe, FrameResult& result);
   void declareWindowBlocks(backend::SchurMarginalizer& m);
   // declareWindowBlocks, then the window's residuals (buildResiduals) and their feature blocks declared in the

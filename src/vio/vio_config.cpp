@@ -39,6 +39,7 @@ std::string VioConfig::validate() const {
   if (!positive(min_parallax_px)) return "min_parallax_px must be > 0";
   if (min_tracked_for_parallax < 0) return "min_tracked_for_parallax must be >= 0";
   if (!positive(focal_px)) return "focal_px must be > 0";
+  if (!nonNegative(max_keyframe_interval_s)) return "max_keyframe_interval_s must be >= 0 (0: off)";
   if (!(seed_max_median_px >= 0)) return "seed_max_median_px must be >= 0 (0: no check)";
   if (seed_min_observations < 1) return "seed_min_observations must be >= 1";
   if (!positive(sigma_px)) return "sigma_px must be > 0";

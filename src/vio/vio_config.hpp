@@ -26,6 +26,12 @@ struct VioConfig {
   double min_parallax_px = 10;     // [px at focal_px] average parallax that makes a keyframe (VINS MIN_PARALLAX)
   int min_tracked_for_parallax = 20;  // fewer features tracked from the previous frame: a keyframe (VINS: 20)
   double focal_px = 460;           // [px] virtual focal length of the parallax test (VINS FOCAL_LENGTH)
+  // Once initialised, a frame this long after the newest keyframe is a keyframe whatever its parallax (0: never, as
+  // VINS-Mono). Without it a window that sees only far features makes no keyframe while the robot drives on, and
+  // the newest frame hangs off the last keyframe by one preintegration over the whole gap, whose position sigma
+  // grows as t^1.5: on the white walls' 30 s the window then held still for seconds and jumped (see
+  // pipeline/visual_motion.hpp).
+  double max_keyframe_interval_s = 0;  // [s]
   double sigma_px = 1.5;           // [px] reprojection sigma at the camera's own focal length (VINS: 1.5 px)
   double robust_px = 1.5;          // [px] Cauchy loss scale on the reprojection error (VINS: Cauchy(1) whitened)
   double outlier_px = 3.0;         // [px] observations with a larger error after the solve are dropped

@@ -40,5 +40,23 @@ TEST(RunPreset, TheLviSamPresetUsesOpenCvsDefaultAndThePlatformPresetChangesNoth
   EXPECT_DOUBLE_EQ(thresholdAfter({Preset::kPlatform, {}}, kSuperPoint, 7e-4), 7e-4);
 }
 
+// The VIS's keyframes: the drover preset adds one every 0.5 s where parallax makes none (unless the platform sets its
+// own interval), the lvi-sam preset and --without keyframe-interval keep VINS-Mono's parallax rule.
+double intervalAfter(const MethodChoice& method, double platform_interval) {
+  io::VisualConfig visual;
+  vio::VioConfig vio;
+  vio.max_keyframe_interval_s = platform_interval;
+  method.apply(visual, vio);
+  return vio.max_keyframe_interval_s;
+}
+
+TEST(RunPreset, TheDroverPresetMakesAKeyframeEveryHalfSecondWithoutParallaxAndLviSamOnlyByParallax) {
+  EXPECT_DOUBLE_EQ(intervalAfter({Preset::kDrover, {}}, 0), 0.5);
+  EXPECT_DOUBLE_EQ(intervalAfter({Preset::kDrover, {}}, 1.0), 1.0) << "a platform's own interval stays";
+  EXPECT_DOUBLE_EQ(intervalAfter({Preset::kDrover, {"keyframe-interval"}}, 1.0), 0);
+  EXPECT_DOUBLE_EQ(intervalAfter({Preset::kLviSam, {}}, 1.0), 0);
+  EXPECT_DOUBLE_EQ(intervalAfter({Preset::kPlatform, {}}, 0.7), 0.7);
+}
+
 }  // namespace
 }  // namespace drover::cli

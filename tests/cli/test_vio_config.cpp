@@ -24,6 +24,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   const vio::VioConfig c = io::loadVioConfig(write(dir, R"(vio:
   window: 7
   min_parallax_px: 12.5
+  max_keyframe_interval_s: 0.75
   sigma_px: 2.0
   depth_mode: factor
   depth_sigma_m: 0.1
@@ -56,6 +57,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
 )"));
   EXPECT_EQ(c.window, 7);
   EXPECT_DOUBLE_EQ(c.min_parallax_px, 12.5);
+  EXPECT_DOUBLE_EQ(c.max_keyframe_interval_s, 0.75);
   EXPECT_DOUBLE_EQ(c.sigma_px, 2.0);
   EXPECT_EQ(c.depth_mode, vio::DepthMode::kFactor);
   EXPECT_DOUBLE_EQ(c.depth_sigma_m, 0.1);

@@ -237,6 +237,23 @@ TEST(VisualMotion, TheStateStreamNumbersTheVisInitialisationsAndSkipsFramesWitho
   EXPECT_EQ(s->initialized_at, 50);
 }
 
+// The stall gate asks when the VIS last saw parallax: a keyframe the window made by time alone
+// (vio.max_keyframe_interval_s, which keeps a stalled window conditioned) does not count as one.
+TEST(VisualMotion, TheStateStreamCountsOnlyKeyframesMadeByParallax) {
+  VisualStateStream stream;
+  vio::FrameResult r;
+  r.t = 20, r.initialized = r.just_initialized = true, r.features = 90;
+  ASSERT_TRUE(stream.onFrame(r));
+  r.t = 30, r.just_initialized = false, r.keyframe = true;
+  EXPECT_EQ(stream.onFrame(r)->last_keyframe_at, 30);
+  r.t = 40, r.keyframe_by_time = true;
+  const std::optional<VisualState> s = stream.onFrame(r);
+  EXPECT_EQ(s->last_keyframe_at, 30);
+  EXPECT_EQ(s->keyframe_interval, 10);
+  r.t = 45, r.keyframe_by_time = false;
+  EXPECT_EQ(stream.onFrame(r)->keyframe_interval, 15);
+}
+
 TEST(VisualMotion, InvalidSettingsAreRefusedNamingTheKey) {
   VisualMotionConfig c;
   c.sigma_position = 0;

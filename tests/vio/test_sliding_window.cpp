@@ -112,6 +112,46 @@ TEST(SlidingWindow, KeepsTheWindowAtItsSizeAndSaysWhyItWaitsBeforeInitialisation
   EXPECT_TRUE(est.initialized());
 }
 
+// vio.max_keyframe_interval_s. Where no frame has the parallax for a keyframe (a threshold none reaches here),
+// VINS-Mono keeps the last keyframe however long ago it was (a new one only when no feature links the frames): the
+// newest frame hangs off it by one preintegration over the whole gap and the estimate drifts off. With the
+// interval a frame becomes a keyframe once it comes that long after the last one (15 Hz and 0.5 s: the 8th frame),
+// flagged as made by time, and the window stays on the truth.
+TEST(SlidingWindow, WithoutParallaxKeyframesMadeByTimeKeepTheWindowOnTheTruth) {
+  const WindowScene scene;
+  double worst[2] = {0, 0};
+  for (const int with : {0, 1}) {
+    VioConfig c = config();
+    c.min_parallax_px = 1e6;
+    c.min_tracked_for_parallax = 0;
+    c.max_keyframe_interval_s = with ? 0.5 : 0.0;
+    SlidingWindowEstimator est(c, imuConfig(), scene.T_imu_cam, 460);
+    WindowRun run{scene};
+    std::optional<double> last_keyframe;
+    int by_time = 0;
+    for (double t = 0.05; t < 8; t += 1.0 / run.camera_hz) {
+      const FrameResult r = run.frame(est, t, truthSeeder(scene));
+      ASSERT_FALSE(r.reset) << r.event;
+      if (!r.initialized) continue;
+      worst[with] = std::max(worst[with], positionError(r, scene));
+      if (!r.keyframe) continue;
+      // The keyframe decided at this frame is the one before it.
+      if (r.keyframe_by_time && last_keyframe) {
+        EXPECT_NEAR(t - *last_keyframe, 8 / run.camera_hz, 1e-6) << "t " << t;
+      }
+      last_keyframe = t;
+      by_time += r.keyframe_by_time ? 1 : 0;
+    }
+    if (with) {
+      EXPECT_GE(by_time, 10);
+    } else {
+      EXPECT_EQ(by_time, 0);
+    }
+  }
+  EXPECT_LT(worst[1], 0.1) << "m";
+  EXPECT_GT(worst[0], 3 * worst[1]) << "m";
+}
+
 TEST(SlidingWindow, EstimatesTheCameraTimeOffset) {
   const WindowScene scene;
   VioConfig c = config();

@@ -32,6 +32,7 @@ vio::VioConfig loadVioConfig(const std::string& yaml_path) {
       .bind("min_parallax_px", c.min_parallax_px)
       .bind("min_tracked_for_parallax", c.min_tracked_for_parallax)
       .bind("focal_px", c.focal_px)
+      .bind("max_keyframe_interval_s", c.max_keyframe_interval_s)
       .bind("sigma_px", c.sigma_px)
       .bind("robust_px", c.robust_px)
       .bind("outlier_px", c.outlier_px)

@@ -2,7 +2,8 @@
 // The `vio:` section of a platform config -> vio::VioConfig (the VIS's sliding window). Every key is optional (left
 // out = the default in src/vio/vio_config.hpp, whose comments give the units); an unknown key or a bad value is an
 // IoError naming the file, the line and the dotted key. Keys:
-//   vio: window, min_parallax_px [px], min_tracked_for_parallax, focal_px [px], sigma_px [px], robust_px [px],
+//   vio: window, min_parallax_px [px], min_tracked_for_parallax, focal_px [px],
+//        max_keyframe_interval_s [s], sigma_px [px], robust_px [px],
 //        outlier_px [px], min_observations, max_features, depth_mode (fixed | factor | off), depth_sigma_m [m],
 //        depth_sigma_rel, depth_sigma_spread, max_iterations, max_solver_ms [ms], estimate_extrinsic (bool),
 //        estimate_time_offset (bool), relative_covariance (bool), time_offset_sigma_s [s], max_time_offset_s [s], imu_midpoint (bool),
