@@ -122,6 +122,7 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  scale_check_span_s: -5\n", "scale_check_span_s must be >= 0"},
            {"vio:\n  scale_check_max_change: 1\n", "scale_check_max_change must be > 1"},
            {"vio:\n  coast_max_s: -1\n", "coast_max_s must be >= 0"},
+           {"vio:\n  max_keyframe_interval_s: -0.5\n", "max_keyframe_interval_s must be >= 0"},
            {"vio:\n  scale_check_bias_sigma: -0.1\n", "scale_check_bias_sigma must be >= 0"},
            {"vio:\n  acc_bias_prior_sigma: -0.05\n", "acc_bias_prior_sigma must be >= 0"},
            {"vio:\n  ground_height_m: -0.4\n", "ground_height_m must be >= 0"},
