@@ -43,6 +43,7 @@ struct MethodChoice {
   std::string describe() const;  // "drover", "drover without vo-factor, superpoint", "platform"
   void apply(pipeline::OdometryConfig& odometry) const;
   void apply(io::VisualConfig& visual, vio::VioConfig& vio) const;
+  bool withoutPart(const std::string& part) const;
 };
 // Throws std::invalid_argument for an unknown part.
 void removePart(const std::string& part, pipeline::OdometryConfig& odometry);

@@ -36,6 +36,7 @@ Json frameLine(const vio::VisFrame& f) {
                {"keyframe", r.keyframe},
                {"keyframe_by_time", r.keyframe_by_time},
                {"detected", f.detected},
+               {"corners_added", f.front_added_corners},
                {"tracked", f.front_tracked},
                {"features", r.features},
                {"with_lidar_depth", r.with_lidar_depth},
@@ -97,12 +98,12 @@ RunVis::RunVis(const VisSetup& setup, const Calibration& calibration, const imu:
       vo_(own_.get()),
       detector_name_(setup.detector_name),
       vio_config_(setup.config.vio),
-      lk_min_eigenvalue_(setup.config.tracker.min_eigenvalue) {}
+      tracker_(setup.config.tracker) {}
 
 RunVis::RunVis(const VisSetup& setup)
     : detector_name_(setup.detector_name),
       vio_config_(setup.config.vio),
-      lk_min_eigenvalue_(setup.config.tracker.min_eigenvalue) {}
+      tracker_(setup.config.tracker) {}
 
 void RunVis::attach(const vio::VisualOdometry* vo, std::size_t frames_in, std::size_t frames_bad) {
   vo_ = vo;
@@ -245,6 +246,8 @@ void VisFrameSums::add(const vio::VisFrame& f) {
   keyframes += r.keyframe ? 1 : 0;
   keyframes_by_time += r.keyframe_by_time ? 1 : 0;
   detected += f.detected ? 1 : 0;
+  topped_up += f.front_added_corners > 0 ? 1 : 0;
+  corners += static_cast<std::size_t>(f.front_added_corners);
   tracked += f.front_tracked, with_depth += r.with_lidar_depth, share_three += f.share_three;
   on_ground += r.on_ground;
   ms.track += f.ms.track, ms.depth += f.ms.depth, ms.solve += f.ms.solve, ms.marginalize += f.ms.marginalize;
@@ -260,7 +263,13 @@ std::optional<pipeline::VisualState> RunVis::takeState() {
 Json RunVis::report() const {
   Json j;
   j["detector"] = detector_name_;
-  j["lk_min_eigenvalue"] = lk_min_eigenvalue_;
+  j["lk_min_eigenvalue"] = tracker_.min_eigenvalue;
+  // Shi-Tomasi corners where the detector left fewer than `below` tracks (visual::FeatureTrackerConfig::top_up_below).
+  if (tracker_.top_up_below > 0)
+    j["corner_top_up"] = {{"below", tracker_.top_up_below},
+                          {"lk_min_eigenvalue", tracker_.top_up_min_eigenvalue},
+                          {"frames", sums_.topped_up},
+                          {"corners", sums_.corners}};
   j["depth_mode"] = vio::toString(vio_config_.depth_mode);
   j["init_mode"] = vio::toString(vio_config_.init);
   j["frames_in"] = frames_in_;

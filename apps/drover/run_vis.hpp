@@ -21,7 +21,7 @@ namespace drover::cli {
 
 // Sums over the recorded frames, for report.json's means.
 struct VisFrameSums {
-  std::size_t frames = 0, keyframes = 0, keyframes_by_time = 0, detected = 0;
+  std::size_t frames = 0, keyframes = 0, keyframes_by_time = 0, detected = 0, topped_up = 0, corners = 0;
   double tracked = 0, with_depth = 0, on_ground = 0, share_three = 0;
   vio::VisStageMs ms;
   void add(const vio::VisFrame& f);
@@ -90,7 +90,7 @@ class RunVis {
   const vio::VisualOdometry* vo_ = nullptr;  // own_, or the System's
   std::string detector_name_;
   vio::VioConfig vio_config_;
-  double lk_min_eigenvalue_ = 0;  // the tracker's, after the preset
+  visual::FeatureTrackerConfig tracker_;  // after the preset
   std::string trajectory_path_;
   Eigen::Isometry3d T_imu_body_ = Eigen::Isometry3d::Identity();
   std::unique_ptr<ImuRateFile> trajectory_;  // opened at the first pose

@@ -53,7 +53,8 @@ VisFrame VisualOdometry::addTracked(Time frame_t, const visual::TrackingResult& 
   out.ms.track = tracks.ms;
   out.front_tracked = tracks.tracked;
   out.front_added = tracks.added;
-  out.detected = tracks.added > 0;
+  out.front_added_corners = tracks.added_corners;
+  out.detected = tracks.added > tracks.added_corners;  // the detector's own points
 
   std::vector<FrameFeature> features(tracks.features.size());
   for (std::size_t k = 0; k < tracks.features.size(); ++k) {

@@ -33,7 +33,8 @@ struct VisStageMs {  // [ms] wall time per stage of one frame
 struct VisFrame {
   FrameResult estimate;
   int front_tracked = 0;     // features the front end carried from the previous frame
-  int front_added = 0;       // new features from the detector
+  int front_added = 0;       // new features from the detector and the corner top-up
+  int front_added_corners = 0;  // of which from the corner top-up
   int depth_associated = 0;  // features with a lidar depth this frame
   bool detected = false;     // the detector ran on this frame
   double share_three = 0;    // of the window's solved features, the share seen in >= 3 window frames

@@ -10,6 +10,8 @@
 #include <opencv2/video/tracking.hpp>
 #include <stdexcept>
 
+#include "visual/shi_tomasi_detector.hpp"
+
 namespace drover::visual {
 
 std::string FeatureTrackerConfig::validate() const {
@@ -18,6 +20,9 @@ std::string FeatureTrackerConfig::validate() const {
   if (!(detect_interval_s >= 0 && detect_interval_s <= 60))
     return "detect_interval_s must be in [0, 60] s, got " + std::to_string(detect_interval_s);
   if (detect_urgent_below < 0) return "detect_urgent_below must be >= 0, got " + std::to_string(detect_urgent_below);
+  if (top_up_below < 0) return "top_up_below must be >= 0, got " + std::to_string(top_up_below);
+  if (!(top_up_min_eigenvalue >= 0) || !std::isfinite(top_up_min_eigenvalue))
+    return "top_up_min_eigenvalue must be finite and >= 0, got " + std::to_string(top_up_min_eigenvalue);
   if (!(min_distance >= 0)) return "min_distance must be >= 0 px, got " + std::to_string(min_distance);
   if (flow_window < 3 || flow_window % 2 == 0)
     return "flow_window must be odd and >= 3, got " + std::to_string(flow_window);
@@ -57,6 +62,7 @@ void FeatureTracker::Tracks::keep(const std::vector<unsigned char>& keep_mask) {
     pixels[j] = pixels[i];
     normalized[j] = normalized[i];
     velocity[j] = velocity[i];
+    corner[j] = corner[i];
     ++j;
   }
   ids.resize(j);
@@ -64,6 +70,7 @@ void FeatureTracker::Tracks::keep(const std::vector<unsigned char>& keep_mask) {
   pixels.resize(j);
   normalized.resize(j);
   velocity.resize(j);
+  corner.resize(j);
 }
 
 FeatureTracker::FeatureTracker(const CameraModel& camera, std::shared_ptr<KeypointDetector> detector,
@@ -72,6 +79,12 @@ FeatureTracker::FeatureTracker(const CameraModel& camera, std::shared_ptr<Keypoi
   if (const std::string error = config.validate(); !error.empty())
     throw std::invalid_argument("FeatureTrackerConfig: " + error);
   if (!detector_) throw std::invalid_argument("FeatureTracker: null detector");
+  if (config_.top_up_below > 0) {
+    ShiTomasiConfig corners;  // VINS-Mono's goodFeaturesToTrack: quality 0.01, MIN_DIST apart
+    corners.max_cnt = config_.max_features;
+    corners.min_dist = config_.min_distance;
+    corners_ = std::make_unique<ShiTomasiDetector>(corners);
+  }
 }
 
 FeatureTracker::~FeatureTracker() {
@@ -140,8 +153,7 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
   std::vector<cv::Point2f> current;
   std::vector<unsigned char> status;
   std::vector<float> error;
-  cv::calcOpticalFlowPyrLK(previous_gray_, gray, tracks_.pixels, current, status, error, window, config_.flow_levels,
-                           criteria, 0, config_.min_eigenvalue);
+  flowWithFloors(gray, current, status);
   std::vector<unsigned char> back_status(status.size(), 1);
   std::vector<cv::Point2f> back;
   if (config_.forward_backward) {
@@ -182,6 +194,31 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
   previous_normalized.resize(j);
   if (config_.ransac) rejectWithFundamental(previous_normalized, result);
   result.tracked = static_cast<int>(tracks_.size());
+}
+
+void FeatureTracker::flowWithFloors(const cv::Mat& gray, std::vector<cv::Point2f>& current,
+                                    std::vector<unsigned char>& status) {
+  const cv::Size window(config_.flow_window, config_.flow_window);
+  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, config_.flow_iterations,
+                                  config_.flow_epsilon);
+  std::vector<float> min_eigenvalues;
+  bool corners = false;
+  for (unsigned char c : tracks_.corner) corners = corners || c;
+  if (!corners) {  // one floor: exactly the detector-only tracker
+    cv::calcOpticalFlowPyrLK(previous_gray_, gray, tracks_.pixels, current, status, min_eigenvalues, window,
+                             config_.flow_levels, criteria, 0, config_.min_eigenvalue);
+    return;
+  }
+  // OpenCV fails a point only at the finest level, when that level's minimum eigenvalue (returned with
+  // OPTFLOW_LK_GET_MIN_EIGENVALS) is below the threshold: so flow at the lower floor, then the detector's tracks held
+  // to theirs, is each track at its own floor (the coarse levels then iterate where they skipped before).
+  const double lower = std::min(config_.min_eigenvalue, config_.top_up_min_eigenvalue);
+  cv::calcOpticalFlowPyrLK(previous_gray_, gray, tracks_.pixels, current, status, min_eigenvalues, window,
+                           config_.flow_levels, criteria, cv::OPTFLOW_LK_GET_MIN_EIGENVALS, lower);
+  for (std::size_t i = 0; i < status.size(); ++i) {
+    const double floor = tracks_.corner[i] ? config_.top_up_min_eigenvalue : config_.min_eigenvalue;
+    if (status[i] && min_eigenvalues[i] < floor) status[i] = 0;
+  }
 }
 
 void FeatureTracker::rejectWithFundamental(const std::vector<Eigen::Vector2d>& previous, TrackingResult& result) {
@@ -226,7 +263,8 @@ TrackingResult FeatureTracker::track(Time t, const cv::Mat& image) {
   result.features.reserve(tracks_.size());
   for (std::size_t i = 0; i < tracks_.size(); ++i)
     result.features.push_back(
-        {tracks_.ids[i], tracks_.lengths[i], tracks_.pixels[i], tracks_.normalized[i], tracks_.velocity[i]});
+        {tracks_.ids[i], tracks_.lengths[i], tracks_.pixels[i], tracks_.normalized[i], tracks_.velocity[i],
+         tracks_.corner[i] != 0});
   result.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

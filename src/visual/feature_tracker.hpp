@@ -5,7 +5,8 @@
 // lengths, and replenishment by a KeypointDetector inside a mask that keeps `min_distance` around live tracks (long
 // tracks claim their neighbourhood first, as VINS-Mono's setMask). Added here: a forward-backward flow check (as
 // VINS-Fusion's FLOW_BACK), optional CLAHE (always or only on dark frames), and asynchronous detection so that a
-// slow detector (SuperPoint, ~0.3-0.6 s a frame on a laptop CPU) does not hold back the camera rate.
+// slow detector (SuperPoint, ~0.3-0.6 s a frame on a laptop CPU) does not hold back the camera rate; and a corner
+// top-up (Shi-Tomasi, each track at its own LK floor) where the detector leaves the tracks short (top_up_below).
 //
 // Synchronous mode (the default; tests and evaluation): the same frames give the same tracks, bit for bit.
 // Asynchronous mode: the detector runs in one worker thread on frame k with the mask of frame k; when its points
@@ -67,6 +68,16 @@ struct FeatureTrackerConfig {
   // SuperPoint) is held; the millisecond ones ignore these two keys.
   double detect_interval_s = 0;     // [s]
   int detect_urgent_below = 0;      // [tracks]
+  // Corner top-up. A learnt detector scores plain walls by what it learnt, not by what LK can follow there: on the
+  // simulated white walls SuperPoint's points fall below its LK floor (min_eigenvalue 2e-3) and leave 6-7 live tracks,
+  // where Shi-Tomasi's corners, picked by that very eigenvalue, keep ~60 at OpenCV's floor.
+  // When fewer than top_up_below tracks come through the flow into a frame, Shi-Tomasi corners (VINS-Mono's
+  // goodFeaturesToTrack, quality 0.01, min_distance apart) fill the free mask up to max_features before the detector's
+  // turn, on the current frame and synchronously (a few ms).
+  // Those tracks keep top_up_min_eigenvalue as their LK floor: a corner is a local maximum of that eigenvalue, so a
+  // weak one is still a corner, not noise. 0 = off (the detector alone).
+  int top_up_below = 0;             // [tracks]
+  double top_up_min_eigenvalue = 1e-4;  // LK floor of the corners' tracks (min_eigenvalue's units)
   std::string validate() const;     // empty = valid, else names the bad value
 };
 
@@ -81,13 +92,15 @@ struct TrackedFeature {
   cv::Point2f pixel;              // [px] in the distorted image
   Eigen::Vector2d normalized;     // undistorted normalised coordinates (x / z, y / z)
   Eigen::Vector2d velocity;       // [normalised units / s], from the previous frame; zero for new features
+  bool corner = false;            // from the corner top-up (FeatureTrackerConfig::top_up_below), not the detector
 };
 
 struct TrackingResult {
   Time t = 0;
   std::vector<TrackedFeature> features;  // every live feature after this frame
   int tracked = 0;            // features carried over from the previous frame (after every check)
-  int added = 0;              // new features from the detector
+  int added = 0;              // new features from the detector and the corner top-up
+  int added_corners = 0;      // of which from the corner top-up (FeatureTrackerConfig::top_up_below)
   int lost_flow = 0;          // LK found no flow
   int rejected_fb = 0;        // forward-backward check
   int rejected_border = 0;    // left the image (or cannot be undistorted)
@@ -126,6 +139,7 @@ class FeatureTracker {
     std::vector<cv::Point2f> pixels;
     std::vector<Eigen::Vector2d> normalized;
     std::vector<Eigen::Vector2d> velocity;
+    std::vector<unsigned char> corner;  // 1 = from the corner top-up (its own LK floor)
     std::size_t size() const { return ids.size(); }
     void keep(const std::vector<unsigned char>& keep_mask);
   };
@@ -134,7 +148,12 @@ class FeatureTracker {
   void rejectWithFundamental(const std::vector<Eigen::Vector2d>& previous, TrackingResult& result);
   cv::Mat crowdMask(TrackingResult& result);
   void replenish(const cv::Mat& gray, TrackingResult& result);
-  void addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result);
+  void detect(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result);
+  void topUp(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result);
+  void addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result,
+                     bool corner = false);
+  // LK with each track's own floor: the detector's tracks min_eigenvalue, the corners' top_up_min_eigenvalue.
+  void flowWithFloors(const cv::Mat& gray, std::vector<cv::Point2f>& current, std::vector<unsigned char>& status);
   bool inside(const cv::Point2f& p) const;
   // Records the tracks keep[i] == 0 drops as finished, for causes[i] (or `cause` for all), and returns keep.
   std::vector<unsigned char> keepFinished(std::vector<unsigned char> keep, const std::vector<TrackEnd>& causes,
@@ -144,6 +163,7 @@ class FeatureTracker {
 
   CameraModel camera_;
   std::shared_ptr<KeypointDetector> detector_;
+  std::unique_ptr<KeypointDetector> corners_;  // the top-up's Shi-Tomasi (null when top_up_below is 0)
   FeatureTrackerConfig config_;
   Tracks tracks_;
   cv::Mat previous_gray_;

@@ -39,7 +39,8 @@ cv::Mat FeatureTracker::crowdMask(TrackingResult& result) {
 
 // Adds detections best first where the mask is free, painting a min_distance disc around each one, so the new
 // points keep the distance from live tracks and from each other whatever the detector's own spacing.
-void FeatureTracker::addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result) {
+void FeatureTracker::addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result,
+                                   bool corner) {
   const int radius = static_cast<int>(std::lround(config_.min_distance));
   for (const cv::Point2f& p : points) {
     if (static_cast<int>(tracks_.size()) >= config_.max_features) break;
@@ -54,7 +55,9 @@ void FeatureTracker::addDetections(const std::vector<cv::Point2f>& points, cv::M
     tracks_.pixels.push_back(p);
     tracks_.normalized.push_back(*xn);
     tracks_.velocity.push_back(Eigen::Vector2d::Zero());
+    tracks_.corner.push_back(corner ? 1 : 0);
     ++result.added;
+    if (corner) ++result.added_corners;
   }
 }
 
@@ -103,6 +106,21 @@ std::vector<cv::Point2f> carry(std::vector<cv::Point2f> points, const cv::Mat& f
 
 void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
   cv::Mat mask = crowdMask(result);
+  topUp(gray, mask, result);
+  detect(gray, mask, result);
+}
+
+// Corners where too few tracks came through the flow into this frame, before the detector's turn: points of a detector
+// that LK cannot follow (SuperPoint's on a plain wall) die at the next frame, and would otherwise claim the mask each
+// time. Not on the first frame: the detector has its first say.
+void FeatureTracker::topUp(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result) {
+  const int live = static_cast<int>(tracks_.size());
+  if (!corners_ || !has_previous_ || live >= config_.top_up_below) return;
+  addDetections(corners_->detect(gray, mask.clone(), detectionCount(config_.max_features - live)).points, mask,
+                result, true);
+}
+
+void FeatureTracker::detect(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result) {
   // Detect-when-needed: a slow detector (SuperPoint) runs only when the live tracks fall below detect_below.
   const int live = static_cast<int>(tracks_.size());
   const bool enough = config_.detect_below > 0 && live >= config_.detect_below;

@@ -152,6 +152,8 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
     async_detection: true
     detect_interval_s: 0.5
     detect_urgent_below: 30
+    top_up_below: 25
+    top_up_min_eigenvalue: 0.0002
   depth: {window_s: 3, voxel_size: 0.1, grid_resolution_deg: 1, neighbour_cells: 4, max_depth_spread: 1.5,
           min_depth: 3, max_depth: 80, min_incidence_cos: 0.1}
 )");
@@ -177,6 +179,8 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
   EXPECT_TRUE(t.async_detection);
   EXPECT_DOUBLE_EQ(t.detect_interval_s, 0.5);
   EXPECT_EQ(t.detect_urgent_below, 30);
+  EXPECT_EQ(t.top_up_below, 25);
+  EXPECT_DOUBLE_EQ(t.top_up_min_eigenvalue, 2e-4);
   const visual::DepthAssociationConfig& d = c.depth;
   EXPECT_DOUBLE_EQ(d.window_s, 3);
   EXPECT_DOUBLE_EQ(d.voxel_size, 0.1);

@@ -15,7 +15,7 @@
 //                     ransac (bool), ransac_threshold_px [px at virtual_focal_px], ransac_confidence,
 //                     virtual_focal_px [px], clahe (off | always | when_dark), clahe_clip, clahe_tiles,
 //                     dark_mean [grey levels], async_detection (bool), detect_below, detect_interval_s [s],
-//                     detect_urgent_below (visual/feature_tracker.hpp)
+//                     detect_urgent_below, top_up_below, top_up_min_eigenvalue (visual/feature_tracker.hpp)
 //     depth:          window_s [s], voxel_size [m], grid_resolution_deg [deg], neighbour_cells [cells],
 //                     max_depth_spread [m], min_depth [m], max_depth [m], min_incidence_cos
 //                                                                              (visual/depth_association.hpp)
