@@ -186,7 +186,7 @@ void MethodChoice::apply(io::VisualConfig& visual, vio::VioConfig& vio) const {
   if (preset == Preset::kDrover && gate && visual.detector.type == visual::DetectorType::kSuperPoint)
     visual.tracker.min_eigenvalue = std::max(visual.tracker.min_eigenvalue, kSuperPointMinEigenvalue);
   // Shi-Tomasi (--without superpoint, the lvi-sam preset) is the corners already: no top-up.
-  if (visual.detector.type != visual::DetectorType::kSuperPoint) visual.tracker.top_up_below = 0;
+  if (visual.detector.type == visual::DetectorType::kShiTomasi) visual.tracker.top_up_below = 0;
 }
 
 }  // namespace drover::cli

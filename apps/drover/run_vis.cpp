@@ -264,7 +264,7 @@ Json RunVis::report() const {
   Json j;
   j["detector"] = detector_name_;
   j["lk_min_eigenvalue"] = tracker_.min_eigenvalue;
-  // Shi-Tomasi corners where the detector left fewer than `below` tracks (visual::FeatureTrackerConfig::top_up_below).
+  // Shi-Tomasi corners where fewer than `below` tracks came through a frame (visual::FeatureTrackerConfig::top_up_below).
   if (tracker_.top_up_below > 0)
     j["corner_top_up"] = {{"below", tracker_.top_up_below},
                           {"lk_min_eigenvalue", tracker_.top_up_min_eigenvalue},

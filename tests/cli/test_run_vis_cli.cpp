@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "io/trajectory_io.hpp"
 #include "support/cli.hpp"
@@ -20,18 +22,25 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 // A platform config with the Shi-Tomasi detector (SuperPoint costs ~0.4 s a frame on these cores).
-std::string shiTomasiConfig(const std::string& name, const fs::path& dir) {
+// The shipped config `name` with each `from` replaced by its `to`, written into `dir`.
+std::string editedConfig(const std::string& name, const fs::path& dir,
+                         const std::vector<std::pair<std::string, std::string>>& edits) {
   std::ifstream in(std::string(DROVER_SOURCE_DIR) + "/config/" + name);
   std::stringstream text;
   text << in.rdbuf();
   std::string yaml = text.str();
-  const std::string from = "type: superpoint ";
-  const auto at = yaml.find(from);
-  EXPECT_NE(at, std::string::npos) << name << " no longer names SuperPoint as its detector";
-  if (at != std::string::npos) yaml.replace(at, from.size(), "type: shi-tomasi ");
+  for (const auto& [from, to] : edits) {
+    const auto at = yaml.find(from);
+    EXPECT_NE(at, std::string::npos) << name << " no longer has '" << from << "'";
+    if (at != std::string::npos) yaml.replace(at, from.size(), to);
+  }
   const fs::path out = dir / name;
   writeText(out, yaml);
   return out.string();
+}
+
+std::string shiTomasiConfig(const std::string& name, const fs::path& dir) {
+  return editedConfig(name, dir, {{"type: superpoint ", "type: shi-tomasi "}});
 }
 
 // Path length of the ground truth between two times [s] and the estimate's displacement over the same span.
@@ -114,6 +123,30 @@ TEST(VisRun, NoLidarRunsTheVisAloneAtMetricScaleAndWritesItsTrajectoryAndReport)
   EXPECT_NEAR(d.estimate / d.truth, 1.0, 0.05) << d.estimate << " m estimated, " << d.truth << " m true";
 }
 
+// The corner top-up's record: ORB topped up below 200 tracks (more than max_features, so at every frame after the
+// first): vis_frames.jsonl's corners_added, and report.json's corner_top_up sums of them.
+TEST(VisRun, TheCornerTopUpIsRecordedPerFrameAndSummedInTheReport) {
+  TempDir dir;
+  const CliResult sim = simulate(dir);
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const std::string config = editedConfig(
+      "farm_sim.yaml", dir.path(), {{"type: superpoint ", "type: orb "}, {"top_up_below: 0 ", "top_up_below: 200 "}});
+  const CliResult run = runDrover("run " + (dir / "straight").string() + " --format sim --config " + config +
+                                  " --no-loop -q --out " + (dir / "run").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const Json v = readJson(dir / "run" / "report.json")["vis"];
+  ASSERT_TRUE(v.contains("corner_top_up")) << v;
+  EXPECT_EQ(v["corner_top_up"]["below"], 200);
+  std::size_t frames = 0, corners = 0;
+  for (const Json& f : readJsonLines(dir / "run" / "vis_frames.jsonl")) {
+    frames += f["corners_added"].get<int>() > 0 ? 1 : 0;
+    corners += f["corners_added"].get<std::size_t>();
+  }
+  EXPECT_GT(frames, 50u) << "the straight course has ~100 frames; the top-up acts wherever ORB leaves room";
+  EXPECT_EQ(v["corner_top_up"]["frames"].get<std::size_t>(), frames);
+  EXPECT_EQ(v["corner_top_up"]["corners"].get<std::size_t>(), corners);
+}
+
 TEST(VisRun, BesideTheLisTheVisStartsFromItAndUsesLidarDepth) {
   TempDir dir;
   const CliResult sim = simulate(dir);
@@ -150,6 +183,7 @@ TEST(VisRun, PresetLviSamRunsLviSamsMethodsAndReportJsonNamesThePresetAndThePart
   EXPECT_EQ(r["vis"]["depth_mode"], "fixed");
   EXPECT_EQ(r["vis"]["detector"], "shi-tomasi");
   EXPECT_EQ(r["vis"]["lk_min_eigenvalue"], 1e-4) << "OpenCV's default, as LVI-SAM's tracker";
+  EXPECT_FALSE(r["vis"].contains("corner_top_up")) << "Shi-Tomasi is the corners already";
   EXPECT_EQ(r["counts"]["vis_factor_scans"], 0) << "LVI-SAM's released code has no visual odometry factor";
   EXPECT_GT(r["counts"]["vis_guess_scans"].get<int>(), 20);
   const CliResult nf = runDrover(base + " -q --no-loop --preset drover --without superpoint --without vo-factor "
