@@ -49,16 +49,8 @@ constexpr double kSuperPointMinEigenvalue = 2e-3;
 // The drover preset's vio.max_keyframe_interval_s where the platform sets none: a window without parallax (far
 // features only, the white walls) still takes a keyframe every ~0.5 s, so that the newest frame never hangs off a
 // keyframe by a preintegration of tens of seconds (vio/vio_config.hpp). A moving VIS makes 7-10 keyframes a second
-// by parallax, so this acts only where it stalls. The LIS's stall gate, which guards parallax-only keyframes, goes
-// with it (MethodChoice::apply).
+// by parallax, so this acts only where it stalls; the LIS's stall gate counts parallax keyframes alone.
 constexpr double kKeyframeInterval = 0.5;  // [s]
-
-// The drover preset's corner top-up where the platform sets none (visual::FeatureTrackerConfig::top_up_below):
-// Shi-Tomasi corners, before SuperPoint's turn, where fewer than this many tracks came through the flow into a frame.
-// On the farm's textured stretches SuperPoint keeps 60-110 (its pass waits while more than detect_urgent_below, 40,
-// live); on the white walls 6-7. At 40 the corners come in only where SuperPoint has lost most of its tracks: on the
-// VIS courses away from the night and the white walls on 0-3 frames of ~540 (bench/RESULTS.md).
-constexpr int kCornerTopUpBelow = 40;  // [tracks]
 
 }  // namespace
 
@@ -110,7 +102,6 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
     visual.detector.type = visual::DetectorType::kSuperPoint;
     vio.depth_mode = vio::DepthMode::kFactor;
     if (vio.max_keyframe_interval_s <= 0) vio.max_keyframe_interval_s = kKeyframeInterval;
-    if (visual.tracker.top_up_below <= 0) visual.tracker.top_up_below = kCornerTopUpBelow;
   } else if (preset == Preset::kLviSam) {
     // LVI-SAM params_camera.yaml: max_cnt 150, min_dist 20, F_threshold 1.0, keyframe_parallax 10, window 10.
     visual.detector.type = visual::DetectorType::kShiTomasi;
@@ -130,7 +121,7 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
 std::vector<std::string> partNames() {
   return {"vo-factor",     "vis-guess", "vis-gates",          "visual-yaw-prior", "scan-context",
           "radius-search", "four-dof",  "loop-fitness-sigma", "vis-carried-sigma", "depth-factor",
-          "superpoint",    "lk-min-eigenvalue", "keyframe-interval", "corner-top-up"};
+          "superpoint",    "lk-min-eigenvalue", "keyframe-interval"};
 }
 
 void removePart(const std::string& part, pipeline::OdometryConfig& odometry) {
@@ -152,7 +143,6 @@ void removePart(const std::string& part, io::VisualConfig& visual, vio::VioConfi
   if (part == "depth-factor") vio.depth_mode = vio::DepthMode::kFixed;
   if (part == "superpoint") visual.detector.type = visual::DetectorType::kShiTomasi;
   if (part == "keyframe-interval") vio.max_keyframe_interval_s = 0;
-  if (part == "corner-top-up") visual.tracker.top_up_below = 0;
 }
 
 std::string MethodChoice::describe() const {
@@ -164,12 +154,6 @@ std::string MethodChoice::describe() const {
 void MethodChoice::apply(pipeline::OdometryConfig& odometry) const {
   applyPreset(preset, odometry);
   for (const std::string& part : without) removePart(part, odometry);
-  // The LIS's stall gate (VisualMotionConfig::max_keyframe_gap) refuses a VIS that makes no keyframe by parallax while
-  // the IMU says it moves: with VINS-Mono's parallax-only keyframes such a window stalls. With keyframes by time it
-  // no longer does, and the gate then refused a VIS that carried the white walls (farm seed 1, Shi-Tomasi: 0.370 m
-  // with it, 0.106 m without; bench/RESULTS.md). So the keyframe-interval part takes the gate out with it.
-  if (preset == Preset::kDrover && !withoutPart("keyframe-interval"))
-    odometry.vis_fusion.max_keyframe_gap = std::numeric_limits<double>::max();
 }
 
 bool MethodChoice::withoutPart(const std::string& part) const {
@@ -181,8 +165,8 @@ void MethodChoice::apply(io::VisualConfig& visual, vio::VioConfig& vio) const {
   for (const std::string& part : without) removePart(part, visual, vio);
   // After the parts: the threshold is for SuperPoint's tracks, so --without superpoint leaves it as the platform's.
   const bool gate = !withoutPart("lk-min-eigenvalue");
-  // The top-up's corners keep the platform's own floor for them (tracker.top_up_min_eigenvalue): picked by that
-  // eigenvalue, a weak corner is still a corner.
+  // A platform's corner top-up (tracker.top_up_below; off in the presets: it failed the farm's fault course, see
+  // bench/RESULTS.md) keeps its own LK floor for the corners (tracker.top_up_min_eigenvalue).
   if (preset == Preset::kDrover && gate && visual.detector.type == visual::DetectorType::kSuperPoint)
     visual.tracker.min_eigenvalue = std::max(visual.tracker.min_eigenvalue, kSuperPointMinEigenvalue);
   // Shi-Tomasi (--without superpoint, the lvi-sam preset) is the corners already: no top-up.

@@ -63,8 +63,6 @@ struct VisualMotionConfig {
   // keyframe is due): a lone keyframe in a stall re-enabled it for 0.5 s, which took the LIS from 0.88 to 0.42 m/s. Gating on the LIS's own
   // velocity instead caught the stall only after it had dragged that velocity down, then locked the recovered VIS
   // out. Gross disagreement with the IMU prediction of the sweep interval (the catch-up jump) is refused too.
-  // The stall came from VINS-Mono's parallax-only keyframes; with vio.max_keyframe_interval_s the window no longer
-  // stalls, and drover run's drover preset switches this gate off (apps/drover/run_preset.cpp).
   double max_keyframe_gap = 0.5;          // [s] (a moving VIS makes 7-10 keyframes a second)
   double standing_speed = 0.2;            // [m/s]
   // ... and the LIS moved at least this far since that keyframe (or between it and the one before): a VIS whose last
