@@ -153,7 +153,7 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
   std::vector<cv::Point2f> current;
   std::vector<unsigned char> status;
   std::vector<float> error;
-  flowWithFloors(gray, current, status);
+  flowWithFloors(gray, window, criteria, current, status);
   std::vector<unsigned char> back_status(status.size(), 1);
   std::vector<cv::Point2f> back;
   if (config_.forward_backward) {
@@ -196,11 +196,8 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
   result.tracked = static_cast<int>(tracks_.size());
 }
 
-void FeatureTracker::flowWithFloors(const cv::Mat& gray, std::vector<cv::Point2f>& current,
-                                    std::vector<unsigned char>& status) {
-  const cv::Size window(config_.flow_window, config_.flow_window);
-  const cv::TermCriteria criteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, config_.flow_iterations,
-                                  config_.flow_epsilon);
+void FeatureTracker::flowWithFloors(const cv::Mat& gray, const cv::Size& window, const cv::TermCriteria& criteria,
+                                    std::vector<cv::Point2f>& current, std::vector<unsigned char>& status) {
   std::vector<float> min_eigenvalues;
   bool corners = false;
   for (unsigned char c : tracks_.corner) corners = corners || c;

@@ -68,15 +68,15 @@ struct FeatureTrackerConfig {
   // SuperPoint) is held; the millisecond ones ignore these two keys.
   double detect_interval_s = 0;     // [s]
   int detect_urgent_below = 0;      // [tracks]
-  // Corner top-up. A learnt detector scores plain walls by what it learnt, not by what LK can follow there: on the
-  // simulated white walls SuperPoint's points fall below its LK floor (min_eigenvalue 2e-3) and leave 6-7 live tracks,
-  // where Shi-Tomasi's corners, picked by that very eigenvalue, keep ~60 at OpenCV's floor.
-  // When fewer than top_up_below tracks come through the flow into a frame, Shi-Tomasi corners (VINS-Mono's
-  // goodFeaturesToTrack, quality 0.01, min_distance apart) fill the free mask up to max_features before the detector's
-  // turn, on the current frame and synchronously (a few ms).
-  // Those tracks keep top_up_min_eigenvalue as their LK floor: a corner is a local maximum of that eigenvalue, so a
-  // weak one is still a corner, not noise. 0 = off (the detector alone; the shipped configs and the presets: on the
-  // farm's fault course the drover preset with 40 drifted 1.2 deg in yaw and ended 11x the fault-free APE).
+  // Corner top-up. When fewer than top_up_below tracks come through the flow into a frame, Shi-Tomasi corners
+  // (VINS-Mono's goodFeaturesToTrack, quality 0.01, min_distance apart) fill the free mask up to max_features before
+  // the detector's turn, on the current frame and synchronously (a few ms). Their tracks keep top_up_min_eigenvalue
+  // as their LK floor. 0 = off (the detector alone; the shipped configs and the presets).
+  // A floor under the camera's noise (~9.5e-4 for the simulated camera) takes points on straight edges, whose
+  // smallest eigenvalue is the noise along the edge: on the simulated white walls 45 % of the corners at 1e-4 lie on
+  // the edges where walls meet floor and ceiling, which look the same from anywhere along the passage, so their
+  // tracks stand still (0.4 % of the true flow) and tell the VIS it is stopped. With 40 at 1e-4 the drover preset's
+  // VIS fell to 0.35x the true speed there on the farm's fault course and took the LIS 11 m off (bench/RESULTS.md).
   int top_up_below = 0;             // [tracks]
   double top_up_min_eigenvalue = 1e-4;  // LK floor of the corners' tracks (min_eigenvalue's units)
   std::string validate() const;     // empty = valid, else names the bad value
@@ -154,7 +154,8 @@ class FeatureTracker {
   void addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result,
                      bool corner = false);
   // LK with each track's own floor: the detector's tracks min_eigenvalue, the corners' top_up_min_eigenvalue.
-  void flowWithFloors(const cv::Mat& gray, std::vector<cv::Point2f>& current, std::vector<unsigned char>& status);
+  void flowWithFloors(const cv::Mat& gray, const cv::Size& window, const cv::TermCriteria& criteria,
+                      std::vector<cv::Point2f>& current, std::vector<unsigned char>& status);
   bool inside(const cv::Point2f& p) const;
   // Records the tracks keep[i] == 0 drops as finished, for causes[i] (or `cause` for all), and returns keep.
   std::vector<unsigned char> keepFinished(std::vector<unsigned char> keep, const std::vector<TrackEnd>& causes,

@@ -233,6 +233,12 @@ TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
   EXPECT_TRUE(has(e, "line 3") && has(e, "min_eigenvalue must be finite and >= 0")) << e;
   e = errorOf(dir, "visual:\n  tracker:\n    detect_interval_s: -1\n");
   EXPECT_TRUE(has(e, "line 3") && has(e, "detect_interval_s must be in [0, 60] s")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    top_up_below: -5\n");
+  EXPECT_TRUE(has(e, "line 3") && has(e, "top_up_below must be >= 0")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    top_up_below: many\n");
+  EXPECT_TRUE(has(e, "line 3") && has(e, "visual.tracker.top_up_below")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    top_up_min_eigenvalue: -1e-4\n");
+  EXPECT_TRUE(has(e, "line 3") && has(e, "top_up_min_eigenvalue must be finite and >= 0")) << e;
   e = errorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
   EXPECT_TRUE(has(e, "visual.depth")) << e;
   EXPECT_TRUE(has(e, "line 3")) << e;
