@@ -20,9 +20,11 @@
 // The ground truth of every lap (10 Hz, T_world_imu) goes to OUT_DIR/bench_memory_truth.tum, for drover eval ape
 // against bench_memory_imu_rate.tum.
 //   build/bench/bench_memory_hour [LAPS=6] [SEED=1] [OUT_DIR=/tmp] [MODE=live|replay|delayed] [LOOP_HZ=1] [CONFIG]
-//                                 [TRIM_S=30]
+//                                 [TRIM_S=30] [CAMERA_DIR]
 // CONFIG: a platform file instead of config/farm_sim.yaml (to try a setting over the hour); TRIM_S: the period of
-// the heap trim [s of data time] (cli::HeapTrimmer's default is drover's).
+// the heap trim [s of data time] (cli::HeapTrimmer's default is drover's). CAMERA_DIR (live only): the full system,
+// drover preset, its VIS fed the frames of that simulated dataset of the same course and seed every lap
+// (bench/memory_hour_camera.hpp); the VIS's estimate goes to OUT_DIR/bench_memory_vis.tum.
 #include <fmt/format.h>
 #include <malloc.h>
 
@@ -40,7 +42,10 @@
 #include <thread>
 
 #include "apps/drover/heap_tuning.hpp"
+#include "apps/drover/run_preset.hpp"
 #include "apps/drover/run_record.hpp"
+#include "apps/drover/run_vis.hpp"
+#include "bench/memory_hour_camera.hpp"
 #include "io/odometry/odometry_config_io.hpp"
 #include "io/trajectory_io.hpp"
 #include "pipeline/loop_worker.hpp"
@@ -71,6 +76,7 @@ struct Lap {
   long rss_kb = 0, peak_kb = 0;
   std::size_t heap_used = 0, heap_free = 0;  // [bytes] malloc's blocks in use, and held free (all arenas, mallinfo2)
   std::size_t sweeps = 0, keyframes = 0, dropped = 0, loops = 0;
+  std::size_t frames = 0, frames_dropped = 0, vis_estimates = 0;  // camera frames the VIS took, dropped, estimated
   std::size_t kf_lis = 0, kf_loop = 0;  // [bytes] keyframe clouds held by the LIS, and by the loop thread alone
   std::size_t retired = 0;               // keyframes whose clouds were freed (a newer one stands for the place)
   std::size_t cache = 0, descriptors = 0;  // [bytes] the local map's world-frame cache, the Scan Context database
@@ -172,8 +178,21 @@ class Runner {
 
 class LiveRunner : public Runner {
  public:
-  LiveRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration, double loop_hz) {
+  // With vis: the VIS in its own thread (camera frames pushed with pushFrame), its estimate streamed to vis_tum.
+  LiveRunner(const pipeline::OdometryConfig& odometry, const Calibration& calibration, double loop_hz,
+             const cli::VisSetup* vis = nullptr, const std::string& vis_tum = {}) {
     pipeline::SystemCallbacks cb;
+    if (vis != nullptr) {
+      vis_tum_ = std::make_unique<io::TumStream>(vis_tum);
+      cb.vis_frame = [this](const vio::VisFrame& f) {
+        if (f.estimate.initialized) {
+          std::lock_guard<std::mutex> lock(record_mutex_);
+          vis_tum_->add({f.estimate.t, f.estimate.T_world_imu});
+          ++vis_estimates_;
+        }
+        ++frames_taken_;
+      };
+    }
     cb.imu_odometry = [this](const pipeline::ImuOdometry& o) { record.imu_rate->add(o.t, o.T_world_imu); };
     cb.sweep = [this](const pipeline::ScanOutcome& s) {
       {
@@ -186,7 +205,8 @@ class LiveRunner : public Runner {
     config.odometry = odometry;
     config.live.sweep_queue = 4;
     config.live.loop_rate_hz = loop_hz;
-    system_ = std::make_unique<pipeline::System>(config, calibration, cb);
+    if (vis != nullptr) config.vis = vis->config;
+    system_ = std::make_unique<pipeline::System>(config, calibration, cb, vis ? vis->detector : nullptr);
   }
   void push(Measurement&& m) override {
     if (auto* imu = std::get_if<ImuSample>(&m)) {
@@ -199,12 +219,24 @@ class LiveRunner : public Runner {
         std::this_thread::sleep_for(std::chrono::microseconds(200));
       ++pushed_;
       system_->pushSweep(std::move(*scan));
+    } else if (auto* frame = std::get_if<CameraFrame>(&m)) {
+      // Likewise for the VIS: a frame goes in once the one before it is taken (or dropped, or refused).
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(1000);
+      while (frames_taken_.load() + stats().frames_dropped + stats().frames_bad + 1 < frames_pushed_ &&
+             std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      ++frames_pushed_;
+      system_->pushFrame(std::move(*frame));
     }
   }
+  pipeline::SystemStats stats() const { return system_->stats(); }
   void fill(Lap& row) override {
     row.sweeps = processed_.load();
     row.dropped = system_->stats().sweeps_dropped;
     row.loops = system_->stats().loops_applied;
+    row.frames = frames_taken_.load();
+    row.frames_dropped = system_->stats().frames_dropped;
+    row.vis_estimates = vis_estimates_.load();
     const pipeline::System::KeyframeMemory kf = system_->keyframeMemory();
     row.kf_lis = kf.lis;
     row.kf_loop = kf.loop;
@@ -219,10 +251,16 @@ class LiveRunner : public Runner {
       }
     });
   }
-  void finish() override { system_->shutdown(); }
+  void finish() override {
+    system_->shutdown();
+    if (vis_tum_) vis_tum_->close();
+  }
 
  private:
   std::unique_ptr<pipeline::System> system_;
+  std::unique_ptr<io::TumStream> vis_tum_;
+  std::atomic<std::size_t> frames_taken_{0}, vis_estimates_{0};
+  std::size_t frames_pushed_ = 0;
   std::atomic<std::size_t> processed_{0};
   std::size_t pushed_ = 0, events_seen_ = 0;
   std::mutex record_mutex_;
@@ -321,10 +359,17 @@ int main(int argc, char** argv) {
   const double loop_hz = argc > 5 ? std::stod(argv[5]) : 1.0;
   const std::string config_path = argc > 6 ? argv[6] : "";
   cli::HeapTrimmer heap(argc > 7 ? fromSeconds(std::stod(argv[7])) : cli::HeapTrimmer::kDefaultPeriod);
+  const std::string camera_dir = argc > 8 ? argv[8] : "";
   if (mode != "live" && mode != "replay" && mode != "delayed") {
     std::fprintf(stderr, "MODE must be live, replay or delayed, not '%s'\n", mode.c_str());
     return 2;
   }
+  if (!camera_dir.empty() && mode != "live") {
+    std::fprintf(stderr, "CAMERA_DIR needs MODE live (the System's VIS thread)\n");
+    return 2;
+  }
+  std::unique_ptr<bench::CameraReplay> camera;
+  if (!camera_dir.empty()) camera = std::make_unique<bench::CameraReplay>(camera_dir);
   sim::ScenarioOptions so;
   so.seed = seed;
   const sim::Scenario scenario = sim::makeScenario("farm", so);
@@ -332,10 +377,21 @@ int main(int argc, char** argv) {
   sc.enable_camera = false;
   // One IMU period after the lap's last sample: the next lap's first (at rest, at the same pose).
   const Time lap_span = sim::Simulator(scenario, sc, seed).groundTruth().back().t + 5'000'000;
-  const Calibration calibration = sim::Simulator(scenario, sc, seed).calibration();
+  const Calibration calibration = camera ? camera->calibration() : sim::Simulator(scenario, sc, seed).calibration();
 
   std::unique_ptr<Runner> runner;
-  if (mode == "live") {
+  if (camera) {
+    // The full system as drover run --preset drover runs it: the preset over the platform file.
+    const std::string platform = config_path.empty() ? std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml"
+                                                     : config_path;
+    const cli::MethodChoice drover{cli::Preset::kDrover, {}};
+    pipeline::OdometryConfig odometry = farmConfig(platform);
+    drover.apply(odometry);
+    const cli::VisSetup vis = cli::loadVisSetup(platform, drover);
+    std::printf("camera: frames of %s every lap, the VIS with %s (drover preset)\n", camera_dir.c_str(),
+                vis.detector_name.c_str());
+    runner = std::make_unique<LiveRunner>(odometry, calibration, loop_hz, &vis, out_dir + "/bench_memory_vis.tum");
+  } else if (mode == "live") {
     runner = std::make_unique<LiveRunner>(farmConfig(config_path), calibration, loop_hz);
   } else if (mode == "delayed") {
     runner = std::make_unique<DelayedRunner>(farmConfig(config_path), calibration, 1.0 / loop_hz);
@@ -360,6 +416,7 @@ int main(int argc, char** argv) {
     // Each lap its own noise (seed + lap); the same world and path: the robot drives the same course again.
     const sim::Simulator simulator(scenario, sc, seed + static_cast<unsigned>(lap) * 1000);
     peaks.startLap();
+    if (camera) camera->startLap(offset);
     const Trajectory lap_truth = simulator.groundTruth();
     for (std::size_t i = 0; i < lap_truth.size(); i += 20)
       truth.add({lap_truth[i].t + offset, lap_truth[i].T_world_body});
@@ -372,6 +429,7 @@ int main(int argc, char** argv) {
         scan->t_end += offset;
       }
       const Time t = measurementTime(m);
+      if (camera) camera->pushUpTo(t, [&](CameraFrame&& f) { runner->push(Measurement(std::move(f))); });
       const bool sweep = std::holds_alternative<LidarScan>(m);
       heap.tick(t);
       runner->push(std::move(m));
@@ -397,6 +455,9 @@ int main(int argc, char** argv) {
                 row.cache / 1048576.0, row.descriptors / 1048576.0, ls.verified, ls.accepted, ls.over_drift_budget,
                 row.graph_refusals, ls.graph_ms, row.graph_iterations, row.max_rotation * 180 / std::numbers::pi,
                 row.graph_nodes, row.heap_used / 1048576.0, row.heap_free / 1048576.0);
+    if (camera)
+      std::printf("  (lap %d: the VIS took %zu frames in all, %zu dropped from its queue, %zu with an estimate)\n",
+                  row.lap, row.frames, row.frames_dropped, row.vis_estimates);
     std::fflush(stdout);
   }
   // DROVER_EXIT_AT_END: leave without freeing anything, so that heaptrack reports what the hour holds at its end
