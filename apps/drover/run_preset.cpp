@@ -115,6 +115,7 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio) {
     // Its feature_tracker calls cv::calcOpticalFlowPyrLK with the default minEigThreshold.
     visual.tracker.min_eigenvalue = visual::FeatureTrackerConfig{}.min_eigenvalue;
     visual.tracker.top_up_below = 0;  // its detector is the corners already
+    visual.tracker.detect_sync_below = 0;
   }
 }
 
@@ -169,8 +170,11 @@ void MethodChoice::apply(io::VisualConfig& visual, vio::VioConfig& vio) const {
   // bench/RESULTS.md) keeps its own LK floor for the corners (tracker.top_up_min_eigenvalue).
   if (preset == Preset::kDrover && gate && visual.detector.type == visual::DetectorType::kSuperPoint)
     visual.tracker.min_eigenvalue = std::max(visual.tracker.min_eigenvalue, kSuperPointMinEigenvalue);
-  // Shi-Tomasi (--without superpoint, the lvi-sam preset) is the corners already: no top-up.
-  if (visual.detector.type == visual::DetectorType::kShiTomasi) visual.tracker.top_up_below = 0;
+  // Shi-Tomasi (--without superpoint, the lvi-sam preset) is the corners already: no top-up, live or replayed.
+  if (visual.detector.type == visual::DetectorType::kShiTomasi) {
+    visual.tracker.top_up_below = 0;
+    visual.tracker.detect_sync_below = 0;
+  }
 }
 
 }  // namespace drover::cli

@@ -19,6 +19,7 @@ std::string FeatureTrackerConfig::validate() const {
   if (detect_below < 0) return "detect_below must be >= 0, got " + std::to_string(detect_below);
   if (!(detect_interval_s >= 0 && detect_interval_s <= 60))
     return "detect_interval_s must be in [0, 60] s, got " + std::to_string(detect_interval_s);
+  if (detect_sync_below < 0) return "detect_sync_below must be >= 0, got " + std::to_string(detect_sync_below);
   if (detect_urgent_below < 0) return "detect_urgent_below must be >= 0, got " + std::to_string(detect_urgent_below);
   if (top_up_below < 0) return "top_up_below must be >= 0, got " + std::to_string(top_up_below);
   if (!(top_up_min_eigenvalue >= 0) || !std::isfinite(top_up_min_eigenvalue))
@@ -79,7 +80,7 @@ FeatureTracker::FeatureTracker(const CameraModel& camera, std::shared_ptr<Keypoi
   if (const std::string error = config.validate(); !error.empty())
     throw std::invalid_argument("FeatureTrackerConfig: " + error);
   if (!detector_) throw std::invalid_argument("FeatureTracker: null detector");
-  if (config_.top_up_below > 0) {
+  if (config_.top_up_below > 0 || (config_.async_detection && config_.detect_sync_below > 0)) {
     ShiTomasiConfig corners;  // VINS-Mono's goodFeaturesToTrack: quality 0.01, MIN_DIST apart
     corners.max_cnt = config_.max_features;
     corners.min_dist = config_.min_distance;

@@ -60,6 +60,14 @@ struct FeatureTrackerConfig {
   int clahe_tiles = 8;              // CLAHE tiles per side (VINS-Mono: 8x8)
   double dark_mean = 60;            // [grey levels] kWhenDark: CLAHE when the frame's mean is below this
   bool async_detection = false;     // run the detector in a worker thread (see above)
+  // With async_detection: fewer live tracks than this and the corner top-up (below) fills the frame at once, at
+  // top_up_min_eigenvalue, while the worker's pass goes on. That pass lands 1-2 frames later, and where tracks die
+  // fast (the farm's jolting stretch) the live VIS ran out of them first: at sensor rate it reset on "only 7 features
+  // tracked (< 8)" again and again there, with an estimate on 17 % of the stretch's frames against 90 % in the
+  // replay. SuperPoint on the frame itself instead took 300-570 ms a frame beside the LIS on 2 cores and the VIS
+  // dropped 687 frames (bench/RESULTS.md). 20 is where the LIS stops taking the VIS (vis_fusion.min_features).
+  // 0: off.
+  int detect_sync_below = 20;       // [tracks]
   int detect_below = 0;             // detect only when fewer live tracks than this (0, or >= max_features: whenever
                                     // below max_features, as VINS-Mono); the VIS's policy for a slow detector
   // A slow detector that finds fewer features than detect_below (SuperPoint on plain walls) would otherwise run at
@@ -78,7 +86,9 @@ struct FeatureTrackerConfig {
   // tracks stand still (0.4 % of the true flow) and tell the VIS it is stopped. With 40 at 1e-4 the drover preset's
   // VIS fell to 0.35x the true speed there on the farm's fault course and took the LIS 11 m off (bench/RESULTS.md).
   int top_up_below = 0;             // [tracks]
-  double top_up_min_eigenvalue = 1e-4;  // LK floor of the corners' tracks (min_eigenvalue's units)
+  // LK floor of the corners' tracks (min_eigenvalue's units): ~2x the simulated camera's noise alone, as the drover
+  // preset's floor for SuperPoint's tracks
+  double top_up_min_eigenvalue = 2e-3;
   std::string validate() const;     // empty = valid, else names the bad value
 };
 
@@ -165,7 +175,8 @@ class FeatureTracker {
 
   CameraModel camera_;
   std::shared_ptr<KeypointDetector> detector_;
-  std::unique_ptr<KeypointDetector> corners_;  // the top-up's Shi-Tomasi (null when top_up_below is 0)
+  // the top-up's Shi-Tomasi (null without top_up_below, or detect_sync_below with async_detection)
+  std::unique_ptr<KeypointDetector> corners_;
   FeatureTrackerConfig config_;
   Tracks tracks_;
   cv::Mat previous_gray_;

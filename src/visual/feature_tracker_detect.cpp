@@ -115,7 +115,8 @@ void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
 // time. Not on the first frame: the detector has its first say.
 void FeatureTracker::topUp(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result) {
   const int live = static_cast<int>(tracks_.size());
-  if (!corners_ || !has_previous_ || live >= config_.top_up_below) return;
+  const int below = std::max(config_.top_up_below, config_.async_detection ? config_.detect_sync_below : 0);
+  if (!corners_ || !has_previous_ || live >= below) return;
   addDetections(corners_->detect(gray, mask.clone(), detectionCount(config_.max_features - live)).points, mask,
                 result, true);
 }

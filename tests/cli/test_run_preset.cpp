@@ -67,6 +67,7 @@ visual::FeatureTrackerConfig trackerAfter(const MethodChoice& method, visual::De
   visual.detector.type = detector;
   visual.tracker.top_up_below = 40;
   visual.tracker.top_up_min_eigenvalue = 5e-4;
+  visual.tracker.detect_sync_below = 20;
   method.apply(visual, vio);
   return visual.tracker;
 }
@@ -80,6 +81,10 @@ TEST(RunPreset, ThePresetsKeepThePlatformsCornerTopUpExceptForShiTomasi) {
   EXPECT_EQ(trackerAfter({Preset::kLviSam, {}}, kSuperPoint).top_up_below, 0);
   EXPECT_EQ(trackerAfter({Preset::kPlatform, {}}, kSuperPoint).top_up_below, 40);
   EXPECT_EQ(trackerAfter({Preset::kPlatform, {}}, kShiTomasi).top_up_below, 0);
+  // The live corners where SuperPoint's worker is late: kept with SuperPoint, not for a Shi-Tomasi detector.
+  EXPECT_EQ(drover.detect_sync_below, 20);
+  EXPECT_EQ(trackerAfter({Preset::kDrover, {"superpoint"}}, kSuperPoint).detect_sync_below, 0);
+  EXPECT_EQ(trackerAfter({Preset::kLviSam, {}}, kSuperPoint).detect_sync_below, 0);
 }
 
 }  // namespace

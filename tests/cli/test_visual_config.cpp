@@ -152,6 +152,7 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
     async_detection: true
     detect_interval_s: 0.5
     detect_urgent_below: 30
+    detect_sync_below: 12
     top_up_below: 25
     top_up_min_eigenvalue: 0.0002
   depth: {window_s: 3, voxel_size: 0.1, grid_resolution_deg: 1, neighbour_cells: 4, max_depth_spread: 1.5,
@@ -179,6 +180,7 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
   EXPECT_TRUE(t.async_detection);
   EXPECT_DOUBLE_EQ(t.detect_interval_s, 0.5);
   EXPECT_EQ(t.detect_urgent_below, 30);
+  EXPECT_EQ(t.detect_sync_below, 12);
   EXPECT_EQ(t.top_up_below, 25);
   EXPECT_DOUBLE_EQ(t.top_up_min_eigenvalue, 2e-4);
   const visual::DepthAssociationConfig& d = c.depth;
@@ -233,6 +235,8 @@ TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
   EXPECT_TRUE(has(e, "line 3") && has(e, "min_eigenvalue must be finite and >= 0")) << e;
   e = errorOf(dir, "visual:\n  tracker:\n    detect_interval_s: -1\n");
   EXPECT_TRUE(has(e, "line 3") && has(e, "detect_interval_s must be in [0, 60] s")) << e;
+  e = errorOf(dir, "visual:\n  tracker:\n    detect_sync_below: -1\n");
+  EXPECT_TRUE(has(e, "line 3") && has(e, "detect_sync_below must be >= 0")) << e;
   e = errorOf(dir, "visual:\n  tracker:\n    top_up_below: -5\n");
   EXPECT_TRUE(has(e, "line 3") && has(e, "top_up_below must be >= 0")) << e;
   e = errorOf(dir, "visual:\n  tracker:\n    top_up_below: many\n");

@@ -231,6 +231,41 @@ TEST(FeatureTracker, AsyncDetectionAddsPointsCarriedToTheCurrentFrame) {
   EXPECT_LT(percentile(errors, 1.0), 0.5);
 }
 
+// Live tracking (async detection): a pass in the worker lands a frame or two later, and where tracks die fast the
+// VIS ran out of them first. Below detect_sync_below Shi-Tomasi corners fill the frame itself. Here a cut keeps only
+// the top-left 200 x 200 px of the view, so a few tracks live on: with the threshold that frame gets corners at
+// once; without it nothing, until the worker's pass (300 ms here) lands.
+TEST(FeatureTracker, BelowDetectSyncBelowAnAsyncTrackerDetectsOnTheFrameItself) {
+  const auto canvas = testing::texture(1000, 800, 9);
+  const auto other = testing::texture(1000, 800, 5);
+  const auto cutFrame = [&](int sync_below) {
+    FeatureTrackerConfig config = baseConfig();
+    config.async_detection = true;
+    config.detect_sync_below = sync_below;
+    FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(30, 300), config);
+    TrackingResult cut;
+    for (int i = 0; i < 4; ++i) {
+      cv::Mat frame = testing::view(canvas, {2.0 * i, 0}, kSize);
+      if (i == 3) {
+        const cv::Rect kept(0, 0, 200, 200);
+        cv::Mat mixed = testing::view(other, {0, 0}, kSize).clone();
+        frame(kept).copyTo(mixed(kept));
+        frame = mixed;
+      }
+      const TrackingResult r = tracker.track(i * kFrameNs, frame);
+      if (i == 3) cut = r;
+    }
+    return cut;
+  };
+  const TrackingResult with = cutFrame(60), without = cutFrame(0);
+  ASSERT_GT(with.tracked, 0) << "some tracks live through the cut";
+  ASSERT_LT(with.tracked, 60);
+  ASSERT_EQ(without.tracked, with.tracked) << "the same frames and tracks up to the cut";
+  EXPECT_GT(with.added_corners, 20) << "corners on the cut frame itself";
+  EXPECT_EQ(with.added, with.added_corners) << "the worker's pass has not landed yet";
+  EXPECT_EQ(without.added, 0) << "the worker's pass has not landed yet";
+}
+
 // Detect-when-needed (the VIS's policy for SuperPoint): with detect_below the detector runs only when the live tracks
 // fall below it; on a texture sliding out of view, tracks are lost at the leading edge, so the detector runs on some
 // frames and not on others, and never while the count is at or above the threshold.

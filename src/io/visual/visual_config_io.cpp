@@ -70,6 +70,7 @@ void bindTracker(YamlSection& s, visual::FeatureTrackerConfig& c, std::string& c
       .bind("detect_below", c.detect_below)
       .bind("detect_interval_s", c.detect_interval_s)
       .bind("detect_urgent_below", c.detect_urgent_below)
+      .bind("detect_sync_below", c.detect_sync_below)
       .bind("top_up_below", c.top_up_below)
       .bind("top_up_min_eigenvalue", c.top_up_min_eigenvalue);
 }
