@@ -3,6 +3,7 @@
 // feature_tracker_detect.cpp.
 #include "visual/feature_tracker.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -80,7 +81,7 @@ FeatureTracker::FeatureTracker(const CameraModel& camera, std::shared_ptr<Keypoi
   if (const std::string error = config.validate(); !error.empty())
     throw std::invalid_argument("FeatureTrackerConfig: " + error);
   if (!detector_) throw std::invalid_argument("FeatureTracker: null detector");
-  if (config_.top_up_below > 0 || (config_.async_detection && config_.detect_sync_below > 0)) {
+  if (cornersBelow() > 0) {
     ShiTomasiConfig corners;  // VINS-Mono's goodFeaturesToTrack: quality 0.01, MIN_DIST apart
     corners.max_cnt = config_.max_features;
     corners.min_dist = config_.min_distance;
@@ -200,9 +201,7 @@ void FeatureTracker::flow(const cv::Mat& gray, double dt, TrackingResult& result
 void FeatureTracker::flowWithFloors(const cv::Mat& gray, const cv::Size& window, const cv::TermCriteria& criteria,
                                     std::vector<cv::Point2f>& current, std::vector<unsigned char>& status) {
   std::vector<float> min_eigenvalues;
-  bool corners = false;
-  for (unsigned char c : tracks_.corner) corners = corners || c;
-  if (!corners) {  // one floor: exactly the detector-only tracker
+  if (std::none_of(tracks_.corner.begin(), tracks_.corner.end(), [](unsigned char c) { return c != 0; })) {  // one floor: exactly the detector-only tracker
     cv::calcOpticalFlowPyrLK(previous_gray_, gray, tracks_.pixels, current, status, min_eigenvalues, window,
                              config_.flow_levels, criteria, 0, config_.min_eigenvalue);
     return;

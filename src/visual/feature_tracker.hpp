@@ -161,6 +161,7 @@ class FeatureTracker {
   void replenish(const cv::Mat& gray, TrackingResult& result);
   void detect(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result);
   void topUp(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result);
+  int cornersBelow() const;  // [tracks] the top-up's threshold: top_up_below, live at least detect_sync_below
   void addDetections(const std::vector<cv::Point2f>& points, cv::Mat& mask, TrackingResult& result,
                      bool corner = false);
   // LK with each track's own floor: the detector's tracks min_eigenvalue, the corners' top_up_min_eigenvalue.
@@ -175,8 +176,7 @@ class FeatureTracker {
 
   CameraModel camera_;
   std::shared_ptr<KeypointDetector> detector_;
-  // the top-up's Shi-Tomasi (null without top_up_below, or detect_sync_below with async_detection)
-  std::unique_ptr<KeypointDetector> corners_;
+  std::unique_ptr<KeypointDetector> corners_;  // the top-up's Shi-Tomasi (null when cornersBelow() is 0)
   FeatureTrackerConfig config_;
   Tracks tracks_;
   cv::Mat previous_gray_;

@@ -112,13 +112,17 @@ void FeatureTracker::replenish(const cv::Mat& gray, TrackingResult& result) {
 
 // Corners where too few tracks came through the flow into this frame, before the detector's turn: points of a detector
 // that LK cannot follow (SuperPoint's on a plain wall) die at the next frame, and would otherwise claim the mask each
-// time. Not on the first frame: the detector has its first say.
+// time. Live (asynchronous detection) also where the worker's pass would land too late (detect_sync_below). Not on
+// the first frame: the detector has its first say.
 void FeatureTracker::topUp(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result) {
   const int live = static_cast<int>(tracks_.size());
-  const int below = std::max(config_.top_up_below, config_.async_detection ? config_.detect_sync_below : 0);
-  if (!corners_ || !has_previous_ || live >= below) return;
+  if (!corners_ || !has_previous_ || live >= cornersBelow()) return;
   addDetections(corners_->detect(gray, mask.clone(), detectionCount(config_.max_features - live)).points, mask,
                 result, true);
+}
+
+int FeatureTracker::cornersBelow() const {
+  return std::max(config_.top_up_below, config_.async_detection ? config_.detect_sync_below : 0);
 }
 
 void FeatureTracker::detect(const cv::Mat& gray, cv::Mat& mask, TrackingResult& result) {
