@@ -247,6 +247,29 @@ TEST(ScanMatcher, ParallelAndSerialSearchGiveBitIdenticalResults) {
   EXPECT_EQ(a.hessian, b.hessian);
 }
 
+TEST(ScanMatcher, ReusingFitsWhoseNeighboursReturnGivesTheRecomputedResultToTheBit) {
+  // Starting 0.3 m and 5 deg off, the first iterations change many points' neighbours and the last ones few: both
+  // the reuse and its refusal are exercised.
+  const LocalMap map = buildMap(sampleMap(kRoom, 0.2));
+  const FeatureSet scan = sampleScan(kRoom, kRoomOffset, 1500, 300, 100.0, 9);
+  ScanMatcherConfig recompute;
+  recompute.reuse_fits = false;
+  const MatchResult reused = ScanMatcher().align(scan, map, Eigen::Isometry3d::Identity());
+  const MatchResult fresh = ScanMatcher(recompute).align(scan, map, Eigen::Isometry3d::Identity());
+  EXPECT_EQ(reused.T_world_lidar.matrix(), fresh.T_world_lidar.matrix());
+  EXPECT_EQ(reused.iterations, fresh.iterations);
+  EXPECT_EQ(reused.hessian, fresh.hessian);
+  EXPECT_EQ(reused.fitness, fresh.fitness);
+  EXPECT_EQ(fresh.fits_reused, 0);
+  ASSERT_GE(reused.iterations, 3);
+  // Every point is fitted in the first iteration; afterwards most keep their neighbours, some do not.
+  const int points = static_cast<int>(scan.edges.size() + scan.planes.size());
+  EXPECT_GE(reused.fits_computed, points * 9 / 10);
+  EXPECT_GT(reused.fits_computed, points * 11 / 10) << "no neighbours changed after the first iteration";
+  EXPECT_GT(reused.fits_reused, points / 5) << reused.fits_computed << " computed, " << reused.iterations << " iterations";
+  EXPECT_EQ(reused.fits_computed + reused.fits_reused, fresh.fits_computed);
+}
+
 TEST(ScanMatcher, RejectsAnInvalidConfig) {
   ScanMatcherConfig config;
   config.max_iterations = 0;
