@@ -5,19 +5,22 @@
 # Run it on a quiet machine: a build beside it takes the cores the LIS needs and the latencies say so.
 #   bash bench/realtime.sh                      # farm course, seed 1
 #   COURSE=overlap SEED=3 bash bench/realtime.sh
+#   COURSE=kitti05-replay bash bench/realtime.sh  # the car (config/car_sim.yaml; needs ../shared/data)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DROVER=${DROVER:-build/apps/drover/drover}
 COURSE=${COURSE:-farm}
 SEED=${SEED:-1}
+# The car has its own platform file (the farm's sensors, LIO-SAM's outdoor map leaf); every farm course the farm's.
+if [ "$COURSE" = kitti05-replay ]; then CONFIG=${CONFIG:-config/car_sim.yaml}; else CONFIG=${CONFIG:-config/farm_sim.yaml}; fi
 OUT=${OUT:-bench/out/realtime}
 DATA="$OUT/sim_${COURSE}_${SEED}"
 mkdir -p "$OUT"
-[ -f "$DATA/calibration.yaml" ] || "$DROVER" sim --scenario "$COURSE" --seed "$SEED" --config config/farm_sim.yaml \
+[ -f "$DATA/calibration.yaml" ] || "$DROVER" sim --scenario "$COURSE" --seed "$SEED" --config "$CONFIG" \
   --no-camera --out "$DATA" --force -q
-"$DROVER" run "$DATA" --format sim --config config/farm_sim.yaml --out "$OUT/${COURSE}_${SEED}_realtime" \
+"$DROVER" run "$DATA" --format sim --config "$CONFIG" --out "$OUT/${COURSE}_${SEED}_realtime" \
   --no-camera --realtime -q
-"$DROVER" run "$DATA" --format sim --config config/farm_sim.yaml --out "$OUT/${COURSE}_${SEED}_replay" --no-camera -q
+"$DROVER" run "$DATA" --format sim --config "$CONFIG" --out "$OUT/${COURSE}_${SEED}_replay" --no-camera -q
 /usr/bin/python3 - "$OUT/${COURSE}_${SEED}_realtime/report.json" "$OUT/${COURSE}_${SEED}_replay/report.json" <<'PY'
 import json, sys
 rt, rp = (json.load(open(p)) for p in sys.argv[1:3])

@@ -4,6 +4,8 @@
 // that test module links drover_io_odometry.)
 #include <gtest/gtest.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <string>
 
 #include "io/error.hpp"
@@ -23,7 +25,8 @@ using test_config::shipped;
 
 TEST(OdometryConfigReader, EveryShippedConfigLoadsAndPassesValidation) {
   for (const char* name :
-       {"kitti.yaml", "kitti_raw.yaml", "m2dgr.yaml", "farm_sim.yaml", "farm_sim_bag.yaml", "euroc.yaml", "lvisam.yaml"}) {
+       {"kitti.yaml", "kitti_raw.yaml", "m2dgr.yaml", "farm_sim.yaml", "farm_sim_bag.yaml", "car_sim.yaml", "euroc.yaml",
+        "lvisam.yaml"}) {
     SCOPED_TRACE(name);
     OdometryConfig c;
     ASSERT_NO_THROW(c = loadOdometryConfig(shipped(name)));
@@ -51,6 +54,27 @@ TEST(OdometryConfigReader, FarmSimConfigGivesTheSimulatorsImuNoiseToTheWholeImuC
   EXPECT_DOUBLE_EQ(c.preintegration.acc_bias_random_walk, 3.0e-4);
   EXPECT_DOUBLE_EQ(c.propagator.gravity, 9.81);
   EXPECT_DOUBLE_EQ(c.initializer.gravity, 9.81);
+}
+
+// The simulated car is the farm's platform with LIO-SAM's outdoor map leaf and the car's ground height: the same
+// sensors (a course rendered with either file is the same data) and, but for the leaf, the same LIS and loops.
+TEST(OdometryConfigReader, CarSimIsTheFarmsPlatformWithTheOutdoorPlaneLeafAndTheCarsGroundHeight) {
+  const YAML::Node farm = YAML::LoadFile(shipped("farm_sim.yaml"));
+  const YAML::Node car = YAML::LoadFile(shipped("car_sim.yaml"));
+  for (const char* section : {"dataset", "sim", "loop", "visual"}) {
+    EXPECT_EQ(YAML::Dump(car[section]), YAML::Dump(farm[section])) << section;
+  }
+  YAML::Node car_odometry = YAML::Clone(car["odometry"]);
+  EXPECT_DOUBLE_EQ(car_odometry["local_map"]["plane_leaf"].as<double>(), 0.4);
+  EXPECT_DOUBLE_EQ(farm["odometry"]["local_map"]["plane_leaf"].as<double>(), 0.2);
+  car_odometry["local_map"]["plane_leaf"] = farm["odometry"]["local_map"]["plane_leaf"];
+  EXPECT_EQ(YAML::Dump(car_odometry), YAML::Dump(farm["odometry"]));
+  EXPECT_DOUBLE_EQ(car["vio"]["ground_height_m"].as<double>(), 1.65);
+  EXPECT_DOUBLE_EQ(farm["vio"]["ground_height_m"].as<double>(), 0.4);
+  YAML::Node car_vio = YAML::Clone(car["vio"]);
+  car_vio["ground_height_m"] = farm["vio"]["ground_height_m"];
+  EXPECT_EQ(YAML::Dump(car_vio), YAML::Dump(farm["vio"]));
+  EXPECT_DOUBLE_EQ(loadOdometryConfig(shipped("car_sim.yaml")).local_map.plane_leaf, 0.4);
 }
 
 TEST(OdometryConfigReader, ConfigsWithoutAnOdometrySectionGiveExactlyTheDefaults) {

@@ -138,7 +138,7 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
 }
 
 TEST(VioConfigIo, TheShippedConfigsLoad) {
-  for (const char* name : {"farm_sim.yaml", "euroc.yaml"}) {
+  for (const char* name : {"farm_sim.yaml", "car_sim.yaml", "euroc.yaml"}) {
     const vio::VioConfig c = io::loadVioConfig(std::string(DROVER_SOURCE_DIR) + "/config/" + name);
     EXPECT_EQ(c.validate(), "") << name;
   }

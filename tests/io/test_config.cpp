@@ -46,7 +46,7 @@ TEST(Config, EveryPlatformFileLoads) {
     EXPECT_NO_THROW(loadDatasetOptions(entry.path().string())) << entry.path();
   }
   for (const char* required : {"kitti.yaml", "kitti_raw.yaml", "euroc.yaml", "m2dgr.yaml", "lvisam.yaml",
-                               "farm_sim.yaml", "farm_sim_bag.yaml"})
+                               "farm_sim.yaml", "farm_sim_bag.yaml", "car_sim.yaml"})
     EXPECT_EQ(names.count(required), 1u) << required;
 }
 
