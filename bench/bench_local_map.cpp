@@ -7,7 +7,7 @@
 #include <algorithm>
 #include <random>
 
-#include "apps/drover/heap_tuning.hpp"
+#include "bench/heap_tuned_main.hpp"
 #include "lidar/local_map.hpp"
 #include "lidar/local_map_voxel.hpp"
 #include "lidar/scan_matcher.hpp"
@@ -116,13 +116,5 @@ BENCHMARK(BM_ScanMatcherAlignOnRoad)->Arg(0)->Arg(1)->Unit(benchmark::kMilliseco
 
 }  // namespace
 
-// As `drover run` does (apps/drover/heap_tuning.hpp): freed buffers stay in the heap, so a rebuild does not fault
-// its ~10 MB of buffers in again each time (on this machine that alone doubled the times, and made them vary).
-int main(int argc, char** argv) {
-  drover::cli::tuneHeapForSweeps();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+// As `drover run` does (apps/drover/heap_tuning.hpp).
+int main(int argc, char** argv) { return drover::bench::runWithTunedHeap(argc, argv); }

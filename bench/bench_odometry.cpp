@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "apps/drover/heap_tuning.hpp"
+#include "bench/heap_tuned_main.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
 #include "io/odometry/odometry_config_io.hpp"
@@ -128,12 +128,5 @@ BENCHMARK(BM_LioKitti00LidarOnly)->Unit(benchmark::kMillisecond)->UseRealTime()-
 
 }  // namespace
 
-// As `drover run` does (apps/drover/heap_tuning.hpp): the benchmark measures the pipeline as the app runs it.
-int main(int argc, char** argv) {
-  drover::cli::tuneHeapForSweeps();
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
-}
+// As `drover run` does (apps/drover/heap_tuning.hpp).
+int main(int argc, char** argv) { return drover::bench::runWithTunedHeap(argc, argv); }
