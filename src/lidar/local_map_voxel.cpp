@@ -78,15 +78,19 @@ void radixSort(std::vector<std::uint64_t>& words, int from, int bits) {
   }
 }
 
-// Centroids of runs of equal keys in words sorted by (key, index); each sum runs in ascending point order.
-void centroids(const PointCloud& cloud, const std::vector<std::uint64_t>& sorted, int index_bits, PointCloud& out) {
-  const std::uint64_t index_mask = (std::uint64_t{1} << index_bits) - 1;
+// Centroids of the runs of equal keys in entries sorted by (key, index): one point a voxel, each sum running over
+// its points in ascending point order, so the result depends on the input alone.
+template <class Entry, class KeyOf, class IndexOf>
+void centroids(const PointCloud& cloud, const std::vector<Entry>& sorted, KeyOf key_of, IndexOf index_of,
+               PointCloud& out) {
   for (std::size_t begin = 0; begin < sorted.size();) {
-    const std::uint64_t key = sorted[begin] >> index_bits;
+    const auto key = key_of(sorted[begin]);
     std::size_t end = begin;
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; end < sorted.size() && (sorted[end] >> index_bits) == key; ++end)
-      sum += cloud[sorted[end] & index_mask].cast<double>();
+    for (; end < sorted.size() && key_of(sorted[end]) == key; ++end) {
+      const Eigen::Vector3f& p = cloud[static_cast<std::size_t>(index_of(sorted[end]))];
+      sum += p.cast<double>();
+    }
     out.push_back((sum / static_cast<double>(end - begin)).cast<float>());
     begin = end;
   }
@@ -94,21 +98,14 @@ void centroids(const PointCloud& cloud, const std::vector<std::uint64_t>& sorted
 
 // Clouds whose box and size need more than 64 bits (voxels kilometres apart at a fine leaf): keys and indices as
 // pairs, compared.
-void centroidsByPairs(const PointCloud& cloud, float inv_leaf, KeyPacking& packing, PointCloud& out) {
+void centroidsByPairs(const PointCloud& cloud, float inv_leaf, const KeyPacking& packing, PointCloud& out) {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     Cell c;
     if (voxelCell(cloud[i], inv_leaf, c)) keyed.emplace_back(packing.key(c), static_cast<std::uint32_t>(i));
   }
   std::sort(keyed.begin(), keyed.end());
-  for (std::size_t begin = 0; begin < keyed.size();) {
-    std::size_t end = begin;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (; end < keyed.size() && keyed[end].first == keyed[begin].first; ++end)
-      sum += cloud[keyed[end].second].cast<double>();
-    out.push_back((sum / static_cast<double>(end - begin)).cast<float>());
-    begin = end;
-  }
+  centroids(cloud, keyed, [](const auto& e) { return e.first; }, [](const auto& e) { return e.second; }, out);
 }
 
 }  // namespace
@@ -149,7 +146,9 @@ PointCloud voxelDownsample(const PointCloud& cloud, float leaf) {
   // Sorted by (key, index), the centroid sums run in a fixed order: bit-identical output for equal input.
   if (words.size() < kRadixFrom) std::sort(words.begin(), words.end());
   else radixSort(words, index_bits, key_bits);
-  centroids(cloud, words, index_bits, out);
+  const std::uint64_t index_mask = (std::uint64_t{1} << index_bits) - 1;
+  centroids(cloud, words, [&](std::uint64_t w) { return w >> index_bits; },
+            [&](std::uint64_t w) { return w & index_mask; }, out);
   return out;
 }
 
