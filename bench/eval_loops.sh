@@ -14,13 +14,15 @@ COURSES=("$@")
 mkdir -p bench/out/loops "$OUT_ROOT/sim"
 for c in "${COURSES[@]}"; do
   data="$OUT_ROOT/sim/${c}_nocam"
+  config=config/farm_sim.yaml
+  [ "$c" = kitti05-replay ] && config=config/car_sim.yaml  # the car's platform file (same sim: section)
   [ -f "$data/scenario.json" ] ||
-    "$DROVER" sim --scenario "$c" --seed 1 --config config/farm_sim.yaml --out "$data" --force -q --no-camera
+    "$DROVER" sim --scenario "$c" --seed 1 --config "$config" --out "$data" --force -q --no-camera
   for mode in loop noloop; do
     flag=()
     [ "$mode" = noloop ] && flag=(--no-loop)
     run="$OUT_ROOT/runs/${c}_$mode"
-    "$DROVER" run "$data" --format sim --config config/farm_sim.yaml --out "$run" -q "${flag[@]}" >/dev/null
+    "$DROVER" run "$data" --format sim --config "$config" --out "$run" -q "${flag[@]}" >/dev/null
     /usr/bin/python3 tools/course_report.py "$data" "$run" --json "bench/out/loops/${c}_$mode.json" >/dev/null
     cp "$run/report.json" "bench/out/loops/${c}_${mode}_report.json"
   done

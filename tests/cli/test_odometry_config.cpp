@@ -58,10 +58,10 @@ TEST(OdometryConfigReader, FarmSimConfigGivesTheSimulatorsImuNoiseToTheWholeImuC
 
 // The simulated car is the farm's platform with LIO-SAM's outdoor map leaf and the car's ground height: the same
 // sensors (a course rendered with either file is the same data) and, but for the leaf, the same LIS and loops.
-TEST(OdometryConfigReader, CarSimIsTheFarmsPlatformWithTheOutdoorPlaneLeafAndTheCarsGroundHeight) {
+TEST(OdometryConfigReader, CarSimIsTheFarmsPlatformWithTheOutdoorPlaneLeafTheCarsGroundHeightAndItsHeadingDrift) {
   const YAML::Node farm = YAML::LoadFile(shipped("farm_sim.yaml"));
   const YAML::Node car = YAML::LoadFile(shipped("car_sim.yaml"));
-  for (const char* section : {"dataset", "sim", "loop", "visual"}) {
+  for (const char* section : {"dataset", "sim", "visual"}) {
     EXPECT_EQ(YAML::Dump(car[section]), YAML::Dump(farm[section])) << section;
   }
   YAML::Node car_odometry = YAML::Clone(car["odometry"]);
@@ -74,7 +74,15 @@ TEST(OdometryConfigReader, CarSimIsTheFarmsPlatformWithTheOutdoorPlaneLeafAndThe
   YAML::Node car_vio = YAML::Clone(car["vio"]);
   car_vio["ground_height_m"] = farm["vio"]["ground_height_m"];
   EXPECT_EQ(YAML::Dump(car_vio), YAML::Dump(farm["vio"]));
-  EXPECT_DOUBLE_EQ(loadOdometryConfig(shipped("car_sim.yaml")).local_map.plane_leaf, 0.4);
+  YAML::Node car_loop = YAML::Clone(car["loop"]);
+  EXPECT_FALSE(farm["loop"]["odometry_sigma_rotation"]) << "the farm keeps the default";
+  car_loop.remove("odometry_sigma_rotation");
+  EXPECT_EQ(YAML::Dump(car_loop), YAML::Dump(farm["loop"]));
+  const OdometryConfig car_config = loadOdometryConfig(shipped("car_sim.yaml"));
+  EXPECT_DOUBLE_EQ(car_config.local_map.plane_leaf, 0.4);
+  EXPECT_DOUBLE_EQ(car_config.loop.odometry_sigma_rotation, 0.0002);
+  EXPECT_DOUBLE_EQ(loadOdometryConfig(shipped("farm_sim.yaml")).loop.odometry_sigma_rotation,
+                   pipeline::LoopClosureConfig{}.odometry_sigma_rotation);
 }
 
 TEST(OdometryConfigReader, ConfigsWithoutAnOdometrySectionGiveExactlyTheDefaults) {
