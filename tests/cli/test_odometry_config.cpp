@@ -57,7 +57,8 @@ TEST(OdometryConfigReader, FarmSimConfigGivesTheSimulatorsImuNoiseToTheWholeImuC
 }
 
 // The simulated car is the farm's platform with LIO-SAM's outdoor map leaf and the car's ground height: the same
-// sensors (a course rendered with either file is the same data) and, but for the leaf, the same LIS and loops.
+// sensors (a course rendered with either file is the same data) and, but for the leaf and the loop graph's rotation
+// sigma (the car's heading drifts 1e-4 rad a keyframe, the farm robot's 1e-3), the same LIS and loops.
 TEST(OdometryConfigReader, CarSimIsTheFarmsPlatformWithTheOutdoorPlaneLeafTheCarsGroundHeightAndItsHeadingDrift) {
   const YAML::Node farm = YAML::LoadFile(shipped("farm_sim.yaml"));
   const YAML::Node car = YAML::LoadFile(shipped("car_sim.yaml"));

@@ -234,25 +234,26 @@ TEST(FeatureTracker, AsyncDetectionAddsPointsCarriedToTheCurrentFrame) {
 // Live tracking (async detection): a pass in the worker lands a frame or two later, and where tracks die fast the
 // VIS ran out of them first. Below detect_sync_below Shi-Tomasi corners fill the frame itself. Here a cut keeps only
 // the top-left 200 x 200 px of the view, so a few tracks live on: with the threshold that frame gets corners at
-// once; without it nothing, until the worker's pass (300 ms here) lands.
+// once; without it nothing, until the worker's pass (500 ms here) lands. The frames are rendered before tracking:
+// rendering them between the calls took ~150 ms a frame on one machine, and the pass had landed by the cut (frames
+// 1-3 track in ~50 ms together).
 TEST(FeatureTracker, BelowDetectSyncBelowAnAsyncTrackerDetectsOnTheFrameItself) {
   const auto canvas = testing::texture(1000, 800, 9);
   const auto other = testing::texture(1000, 800, 5);
+  std::vector<cv::Mat> frames;
+  for (int i = 0; i < 4; ++i) frames.push_back(testing::view(canvas, {2.0 * i, 0}, kSize));
+  const cv::Rect kept(0, 0, 200, 200);
+  cv::Mat mixed = testing::view(other, {0, 0}, kSize).clone();
+  frames[3](kept).copyTo(mixed(kept));
+  frames[3] = mixed;
   const auto cutFrame = [&](int sync_below) {
     FeatureTrackerConfig config = baseConfig();
     config.async_detection = true;
     config.detect_sync_below = sync_below;
-    FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(30, 300), config);
+    FeatureTracker tracker(pinhole(), std::make_shared<GfttDetector>(30, 500), config);
     TrackingResult cut;
     for (int i = 0; i < 4; ++i) {
-      cv::Mat frame = testing::view(canvas, {2.0 * i, 0}, kSize);
-      if (i == 3) {
-        const cv::Rect kept(0, 0, 200, 200);
-        cv::Mat mixed = testing::view(other, {0, 0}, kSize).clone();
-        frame(kept).copyTo(mixed(kept));
-        frame = mixed;
-      }
-      const TrackingResult r = tracker.track(i * kFrameNs, frame);
+      const TrackingResult r = tracker.track(i * kFrameNs, frames[i]);
       if (i == 3) cut = r;
     }
     return cut;
