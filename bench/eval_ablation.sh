@@ -20,12 +20,6 @@ cd "$(dirname "$0")/.."
 BUILD_DIR=${DROVER_BUILD_DIR:-build}
 OUT_ROOT=${DROVER_OUT:-out}
 DROVER="$BUILD_DIR/apps/drover/drover"
-# The platform file: ABLATION_CONFIG if set, else the car's for kitti05-replay and the farm's for every other course.
-course_config() {
-  if [ -n "${ABLATION_CONFIG:-}" ]; then echo "$ABLATION_CONFIG"
-  elif [ "$1" = kitti05-replay ]; then echo config/car_sim.yaml
-  else echo config/farm_sim.yaml; fi
-}
 read -r -a COURSES <<< "${ABLATION_COURSES:-corridor white-walls lighting farm farm-2 farm-3}"
 read -r -a ROWS <<< "${ABLATION_ROWS:-lis vis lvi-sam drover drover-vo-factor drover-vis-gates drover-visual-yaw-prior drover-scan-context drover-radius-search drover-four-dof drover-loop-fitness-sigma drover-vis-carried-sigma drover-depth-factor drover-superpoint drover-keyframe-interval}"
 read -r -a EXTRA <<< "${ABLATION_DROVER_EXTRA:-}"
@@ -50,7 +44,7 @@ for c in "${COURSES[@]}"; do
   scenario=$c seed=1
   case "$c" in farm-*) scenario=farm seed=${c#farm-} ;; esac
   data="$OUT_ROOT/sim/$c-cam"
-  CONFIG=$(course_config "$c")
+  CONFIG=${ABLATION_CONFIG:-$(platform_config "$c")}
   course_is_current "$data" "$CONFIG" ||
     "$DROVER" sim --scenario "$scenario" --seed "$seed" --config "$CONFIG" --out "$data" --force -q
   mkdir -p "bench/out/ablation/$c" "$OUT_ROOT/ablation/$c"

@@ -6,6 +6,7 @@
 # Usage: bash bench/eval_loops.sh [course ...]. Needs ../shared/data for kitti05-replay. About 10 min per course.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+. scripts/sim_cache.sh
 BUILD_DIR=${DROVER_BUILD_DIR:-build}
 OUT_ROOT=${DROVER_OUT:-out}
 DROVER="$BUILD_DIR/apps/drover/drover"
@@ -14,8 +15,7 @@ COURSES=("$@")
 mkdir -p bench/out/loops "$OUT_ROOT/sim"
 for c in "${COURSES[@]}"; do
   data="$OUT_ROOT/sim/${c}_nocam"
-  config=config/farm_sim.yaml
-  [ "$c" = kitti05-replay ] && config=config/car_sim.yaml  # the car's platform file (same sim: section)
+  config=$(platform_config "$c")
   [ -f "$data/scenario.json" ] ||
     "$DROVER" sim --scenario "$c" --seed 1 --config "$config" --out "$data" --force -q --no-camera
   for mode in loop noloop; do

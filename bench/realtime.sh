@@ -12,7 +12,8 @@ DROVER=${DROVER:-build/apps/drover/drover}
 COURSE=${COURSE:-farm}
 SEED=${SEED:-1}
 # The car has its own platform file (the farm's sensors, LIO-SAM's outdoor map leaf); every farm course the farm's.
-if [ "$COURSE" = kitti05-replay ]; then CONFIG=${CONFIG:-config/car_sim.yaml}; else CONFIG=${CONFIG:-config/farm_sim.yaml}; fi
+. scripts/sim_cache.sh
+CONFIG=${CONFIG:-$(platform_config "$COURSE")}
 OUT=${OUT:-bench/out/realtime}
 DATA="$OUT/sim_${COURSE}_${SEED}"
 mkdir -p "$OUT"

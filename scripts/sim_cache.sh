@@ -11,3 +11,9 @@ course_is_current() {
   have=$(sed -n 's/^    pixel_samples: *\([0-9][0-9]*\).*/\1/p' "$dir/calibration.yaml")
   [ "${want:-1}" = "${have:-1}" ]
 }
+
+# platform_config COURSE: the platform file a course runs with: the car's for kitti05-replay, the farm's otherwise
+# (both have the same sim: section, so either renders the same data).
+platform_config() {
+  if [ "$1" = kitti05-replay ]; then echo config/car_sim.yaml; else echo config/farm_sim.yaml; fi
+}

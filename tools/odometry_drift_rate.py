@@ -33,8 +33,13 @@ def main():
     for f in (os.path.join(a.dataset, "groundtruth.txt"), os.path.join(a.run, "keyframes.tum")):
         if not os.path.isfile(f):
             sys.exit(f"odometry_drift_rate: {f}: no such file")
-    gt_times, gt = load_tum(os.path.join(a.dataset, "groundtruth.txt"))
-    kf_times, kf = load_tum(os.path.join(a.run, "keyframes.tum"))
+    loaded = []
+    for f in (os.path.join(a.dataset, "groundtruth.txt"), os.path.join(a.run, "keyframes.tum")):
+        try:
+            loaded.append(load_tum(f))
+        except (ValueError, IndexError) as e:
+            sys.exit(f"odometry_drift_rate: {f}: not a TUM trajectory (t x y z qx qy qz qw a line): {e}")
+    (gt_times, gt), (kf_times, kf) = loaded
     pairs = [(e, g) for t, e in zip(kf_times, kf) if (g := gt_at(gt_times, gt, t)) is not None]
     if len(pairs) < 2:
         sys.exit(f"odometry_drift_rate: {a.run}/keyframes.tum: fewer than 2 keyframes within the ground truth")

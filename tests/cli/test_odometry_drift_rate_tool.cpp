@@ -69,5 +69,17 @@ TEST(OdometryDriftRateTool, NamesTheMissingFileAndFails) {
   EXPECT_NE(r.output.find("groundtruth.txt: no such file"), std::string::npos) << r.output;
 }
 
+TEST(OdometryDriftRateTool, NamesAFileThatIsNotATrajectoryAndFails) {
+  test::TempDir dir;
+  test::writeText(dir / "course" / "groundtruth.txt", tumLine(0, 0, 0) + tumLine(1, 1, 0));
+  test::writeText(dir / "run" / "keyframes.tum", "0 1 2\n");
+  const test::CliResult r = test::runShell("/usr/bin/python3 " + std::string(DROVER_SOURCE_DIR) +
+                                          "/tools/odometry_drift_rate.py " + (dir / "course").string() + " " +
+                                          (dir / "run").string() + " 2>&1");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("keyframes.tum: not a TUM trajectory"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("Traceback"), std::string::npos) << r.output;
+}
+
 }  // namespace
 }  // namespace drover
