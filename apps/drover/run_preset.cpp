@@ -94,6 +94,7 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
     odometry.degenerate_pose_from_match = true;
     loop.four_dof_with_imu = false;  // LIO-SAM's keyframe graph (iSAM2) corrects all 6 DoF
     loop.verifier.sigma_fitness_reference = 0.0;  // its loop noise is the ICP fitness score alone
+    odometry.static_hold.sigma = 0.0;              // LIO-SAM's IMU graph knows only its first velocity
   }
 }
 

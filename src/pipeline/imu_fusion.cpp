@@ -52,7 +52,8 @@ ImuFusion::ImuFusion(const OdometryConfig& config, const Eigen::Isometry3d& T_im
       initializer_(config.initializer),
       smoother_(config.smoother),
       visual_(config.vis_fusion, config.preintegration),
-      visual_watch_(config.vis_fusion.reset_after) {}
+      visual_watch_(config.vis_fusion.reset_after),
+      hold_(config.static_hold) {}
 
 imu::SampleStatus ImuFusion::addImu(const ImuSample& sample) { return propagator_.addSample(sample); }
 
@@ -90,6 +91,7 @@ void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
   // At rest by the IMU window: the velocity is known (zero), not merely unknown around zero.
   if (r.is_static && config_.static_start_sigma_velocity > 0)
     smoother_.setFirstVelocitySigma(config_.static_start_sigma_velocity);
+  if (r.is_static) beginStaticHold(window);
   initialized_ = true;
   sweeps_to_moving_restart_ = config_.moving_start_restart > 0 ? config_.moving_start_restart : kDone;
   static_start_ = r.is_static;
@@ -171,6 +173,7 @@ bool ImuFusion::restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3
   const Eigen::Vector3d v_world = (T_world_imu_measured.translation() - T_world_imu_previous.translation()) / dt;
   if (static_start_ && v_world.norm() <= config_.moving_start_speed) return false;  // at rest indeed
   restart({out.t, T_world_imu_measured, v_world}, start_bias_);
+  hold_ = StaticHold(config_.static_hold);  // not at rest after all
   init_note_ += fmt::format("; moving at {:.2f} m/s by the lidar: the smoother restarted {:.2f} s in with that velocity",
                             v_world.norm(), toSeconds(out.t - t_start_));
   return true;
@@ -232,6 +235,10 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     }
     out.vis_reset = visual_watch_.onSweep(out.t, inc.has_value(), disagreed ? why : std::string());
   }
+  if (holdAtRest(samples, previous.t, out.t)) {
+    visual = backend::RelativePoseMeasurement{Eigen::Isometry3d::Identity(), zeroMotionSqrtInformation()};
+    out.vis_factor = false;
+  }
   backend::SmootherUpdate r;
   try {
     imu::Preintegrator pim(smoother_.bias(), config_.preintegration);
@@ -267,6 +274,32 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   } else if (config_.gravity_roll_pitch) {
     out.T_world_lidar.linear() = geometry::withRollPitchOf(out.T_world_lidar.linear(), T_world_lidar_fused.linear());
   }
+}
+
+// The rest is what the initialiser's window read: its mean specific force and angular rate (IMU frame).
+void ImuFusion::beginStaticHold(const std::vector<ImuSample>& window) {
+  if (window.empty()) return;
+  Eigen::Vector3d f = Eigen::Vector3d::Zero(), w = Eigen::Vector3d::Zero();
+  for (const ImuSample& s : window) {
+    f += s.acc_imu;
+    w += s.omega_imu;
+  }
+  const double n = static_cast<double>(window.size());
+  hold_.begin(window.back().t, f / n, w / n);
+}
+
+// Whether the sweep (a, b] is still at rest since the static start; the report's IMU note says when the hold ended.
+bool ImuFusion::holdAtRest(const std::vector<ImuSample>& samples, Time a, Time b) {
+  if (!hold_.holding()) return false;
+  if (hold_.stillAtRest(samples, a, b)) return true;
+  init_note_ += fmt::format("; held at rest until {:.2f} s ({})", toSeconds(hold_.endedAt() - t_start_),
+                            hold_.endReason());
+  return false;
+}
+
+// Zero motion between two sweeps at rest, [dp (m); dtheta (rad)] each with the hold's sigma.
+Eigen::Matrix<double, 6, 6> ImuFusion::zeroMotionSqrtInformation() const {
+  return Eigen::Matrix<double, 6, 6>::Identity() / config_.static_hold.sigma;
 }
 
 std::optional<Eigen::Isometry3d> ImuFusion::visualLidarGuess(Time t, const StampedPose& previous,

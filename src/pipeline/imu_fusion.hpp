@@ -14,6 +14,7 @@
 #include "lidar/deskew.hpp"
 #include "pipeline/odometry_config.hpp"
 #include "pipeline/path_odometer.hpp"
+#include "pipeline/static_hold.hpp"
 #include "pipeline/visual_motion.hpp"
 #include "types/imu.hpp"
 #include "types/trajectory.hpp"
@@ -90,6 +91,9 @@ class ImuFusion {
                                const Trajectory& trajectory);
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
   std::optional<Eigen::Matrix<double, 6, 6>> biasCovarianceAfter(double gap) const;
+  void beginStaticHold(const std::vector<ImuSample>& window);
+  bool holdAtRest(const std::vector<ImuSample>& samples, Time a, Time b);
+  Eigen::Matrix<double, 6, 6> zeroMotionSqrtInformation() const;
 
   OdometryConfig config_;
   Eigen::Isometry3d T_imu_lidar_, T_lidar_imu_;
@@ -99,6 +103,7 @@ class ImuFusion {
   VisualMotion visual_;
   VisualWatch visual_watch_;
   PathOdometer odometer_;  // the fused states' path, for the VIS's keyframe gate
+  StaticHold hold_;        // a static start held at rest until the IMU says it moved (config.static_hold)
   bool initialized_ = false, given_up_ = false;
   Time t_start_ = 0;                  // [ns] the first sweep's stamp
   // Sweeps left until the moving-start check (> 0), then its retries (<= 0); kDone when judged or disabled.

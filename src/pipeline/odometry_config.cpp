@@ -49,7 +49,7 @@ std::string OdometryConfig::validate() const {
       {"keyframes", keyframes.validate()},    {"preintegration", preintegration.validate()},
       {"propagator", propagator.validate()},  {"initializer", initializer.validate()},
       {"smoother", smoother.validate()},      {"loop", loop.validate()},
-      {"vis_fusion", vis_fusion.validate()}};
+      {"vis_fusion", vis_fusion.validate()},  {"static_hold", static_hold.validate()}};
   for (const auto& [name, error] : parts)
     if (!error.empty()) return prefixed(name, error);
   return {};

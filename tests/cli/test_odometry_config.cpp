@@ -406,6 +406,18 @@ TEST(OdometryConfigReader, ANegativeMovingOrStaticStartSettingIsAnErrorNamingThe
   EXPECT_TRUE(has(s, "section 'odometry'") && has(s, "static_start_sigma_velocity must be finite and >= 0")) << s;
 }
 
+TEST(OdometryConfigReader, TheStaticHoldKeysReachTheirFieldsAndANegativeSigmaIsAnErrorNamingTheKey) {
+  test::TempDir dir;
+  const OdometryConfig c =
+      load(dir, "odometry:\n  static_hold:\n    sigma: 0.002\n    max_velocity: 0.03\n    max_rotation: 0.02\n");
+  EXPECT_DOUBLE_EQ(c.static_hold.sigma, 0.002);
+  EXPECT_DOUBLE_EQ(c.static_hold.max_velocity, 0.03);
+  EXPECT_DOUBLE_EQ(c.static_hold.max_rotation, 0.02);
+  EXPECT_EQ(OdometryConfig{}.static_hold.sigma, 0.0) << "off by default";
+  const std::string e = errorOf(dir, "odometry:\n  static_hold:\n    sigma: -0.001\n");
+  EXPECT_TRUE(has(e, "section 'odometry'") && has(e, "static_hold: sigma must be finite and >= 0")) << e;
+}
+
 TEST(OdometryConfigReader, APlaneAspectOutsideZeroToOneIsAnErrorNamingFileAndKey) {
   test::TempDir dir;
   const std::string file = (dir / "odometry.yaml").string();

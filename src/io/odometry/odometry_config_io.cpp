@@ -176,7 +176,12 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       })
       .nested("imu", [&](YamlSection& s) { bindImu(s, c.preintegration); })
       .nested("smoother", [&](YamlSection& s) { bindSmoother(s, c.smoother); })
-      .nested("vis_fusion", [&](YamlSection& s) { bindVisFusion(s, c.vis_fusion); });
+      .nested("vis_fusion", [&](YamlSection& s) { bindVisFusion(s, c.vis_fusion); })
+      .nested("static_hold", [&](YamlSection& s) {
+        s.bind("sigma", c.static_hold.sigma)
+            .bind("max_velocity", c.static_hold.max_velocity)
+            .bind("max_rotation", c.static_hold.max_rotation);
+      });
   top.apply(root["odometry"]);
   applyEnums(e, c);
   // The loop closure has its own top-level section; the matcher and submap of its verifier follow the odometry's.

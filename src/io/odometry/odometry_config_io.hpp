@@ -26,6 +26,8 @@
 //                   keyframe_gap_min_distance [m], max_velocity_difference [m/s],
 //                   max_position_difference [m], max_acceleration_difference [m/s^2], reset_after [s]
 //                   (pipeline/visual_motion.hpp)
+//     static_hold:  sigma [m and rad per sweep; 0 = off], max_velocity [m/s], max_rotation [rad] (a static start
+//                   held at rest until the IMU says it moved: pipeline/static_hold.hpp)
 //   loop: (its own top-level section) see io/odometry/loop_config_io.hpp
 // Lives in its own library (drover_io_odometry) so that the readers do not depend on the odometry modules.
 #include <string>
