@@ -276,15 +276,19 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   }
 }
 
-// The rest is what the initialiser's window read: its mean specific force and angular rate (IMU frame).
+// The rest is what the initialiser judged: the mean specific force and angular rate (IMU frame) of the newest
+// initializer.window_s of the samples.
 void ImuFusion::beginStaticHold(const std::vector<ImuSample>& window) {
   if (window.empty()) return;
+  const Time from = window.back().t - fromSeconds(config_.initializer.window_s);
   Eigen::Vector3d f = Eigen::Vector3d::Zero(), w = Eigen::Vector3d::Zero();
+  int n = 0;
   for (const ImuSample& s : window) {
+    if (s.t < from) continue;
     f += s.acc_imu;
     w += s.omega_imu;
+    ++n;
   }
-  const double n = static_cast<double>(window.size());
   hold_.begin(window.back().t, f / n, w / n);
 }
 
