@@ -75,7 +75,7 @@ struct OdometryConfig {
   // moved (pipeline/static_hold.hpp): the start's rest held, not only its first velocity. Off (sigma 0) by default,
   // in the presets too. On the simulated corridor (drover preset, seeds 1-3, 2x2 frames) it estimates the start's
   // accelerometer bias along the axis (0.013-0.015 m/s^2 against the IMU's true ~0.02; 0.000 without) and the start
-  // is right (0.01 m off at 4 s against 0.08-0.13 m), but the run's error is set later by the VIS's scale along the
+  // is right (0.01 m off at 4 s against 0.07-0.13 m), but the run's error is set later by the VIS's scale along the
   // corridor, which pulls that bias off again: APE 0.146 / 0.106 / 0.144 -> 0.167 / 0.150 / 0.136 m
   // (bench/RESULTS.md).
   StaticHoldConfig static_hold;
