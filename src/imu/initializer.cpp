@@ -119,6 +119,8 @@ StaticInitializer::Result StaticInitializer::initialize(const std::vector<ImuSam
   result.gyro_std = w.gyro_std;
   result.acc_std = w.acc_std;
   result.gravity_magnitude = w.mean_acc.norm();
+  result.mean_specific_force = w.mean_acc;
+  result.window_end = w.last;
   result.q_world_imu = attitudeFromGravity(w.mean_acc);
   result.reason = staticFailures(w, config_);
   result.is_static = result.reason.empty();

@@ -40,6 +40,8 @@ class StaticInitializer {
     Eigen::Quaterniond q_world_imu = Eigen::Quaterniond::Identity();
     ImuBias bias;                      // gyro: mean rate when static, else zero; acc: zero
     double gravity_magnitude = 0;      // [m/s^2] norm of the mean specific force
+    Eigen::Vector3d mean_specific_force = Eigen::Vector3d::Zero();  // [m/s^2] over the window, IMU frame
+    Time window_end = 0;               // [ns] the newest finite sample of the window
     double gyro_std = 0, acc_std = 0;  // [rad/s], [m/s^2] the measured spreads
     double tilt_mismatch = 0;          // [rad] angle between the 9-axis "up" and the mean specific force (0 if
                                        // no orientation was used)

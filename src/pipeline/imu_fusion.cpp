@@ -91,7 +91,8 @@ void ImuFusion::tryInitialize(Time t0, bool first_sweep) {
   // At rest by the IMU window: the velocity is known (zero), not merely unknown around zero.
   if (r.is_static && config_.static_start_sigma_velocity > 0)
     smoother_.setFirstVelocitySigma(config_.static_start_sigma_velocity);
-  if (r.is_static) beginStaticHold(window);
+  // The rest is what the initialiser judged: its window's mean specific force and rate (the gyro bias).
+  if (r.is_static) hold_.begin(r.window_end, r.mean_specific_force, r.bias.gyro);
   initialized_ = true;
   sweeps_to_moving_restart_ = config_.moving_start_restart > 0 ? config_.moving_start_restart : kDone;
   static_start_ = r.is_static;
@@ -274,22 +275,6 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   } else if (config_.gravity_roll_pitch) {
     out.T_world_lidar.linear() = geometry::withRollPitchOf(out.T_world_lidar.linear(), T_world_lidar_fused.linear());
   }
-}
-
-// The rest is what the initialiser judged: the mean specific force and angular rate (IMU frame) of the newest
-// initializer.window_s of the samples.
-void ImuFusion::beginStaticHold(const std::vector<ImuSample>& window) {
-  if (window.empty()) return;
-  const Time from = window.back().t - fromSeconds(config_.initializer.window_s);
-  Eigen::Vector3d f = Eigen::Vector3d::Zero(), w = Eigen::Vector3d::Zero();
-  int n = 0;
-  for (const ImuSample& s : window) {
-    if (s.t < from) continue;
-    f += s.acc_imu;
-    w += s.omega_imu;
-    ++n;
-  }
-  hold_.begin(window.back().t, f / n, w / n);
 }
 
 // Whether the sweep (a, b] is still at rest since the static start; the report's IMU note says when the hold ended.

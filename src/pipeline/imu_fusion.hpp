@@ -91,7 +91,6 @@ class ImuFusion {
                                const Trajectory& trajectory);
   Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
   std::optional<Eigen::Matrix<double, 6, 6>> biasCovarianceAfter(double gap) const;
-  void beginStaticHold(const std::vector<ImuSample>& window);
   bool holdAtRest(const std::vector<ImuSample>& samples, Time a, Time b);
   Eigen::Matrix<double, 6, 6> zeroMotionSqrtInformation() const;
 
