@@ -30,6 +30,7 @@ namespace {
 void withoutGates(pipeline::VisualMotionConfig& f) {
   constexpr double kNever = std::numeric_limits<double>::max();
   f.max_keyframe_gap = f.max_velocity_difference = f.max_position_difference = f.max_acceleration_difference = kNever;
+  f.max_velocity_difference_ratio = f.max_velocity_difference_growth = 0;
   f.reset_after = 0;
   f.min_features = 1;
 }

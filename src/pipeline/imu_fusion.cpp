@@ -119,6 +119,7 @@ void ImuFusion::restart(const imu::NavState& state, const imu::ImuBias& bias,
   }
   propagator_.reset(state, bias);
   odometer_.add(state.t, state.T_world_imu.translation());
+  velocity_measured_at_ = state.t;
 }
 
 // The smoother restarts in the corrected world (LIO-SAM resets its IMU graph on the corrected odometry), but the
@@ -138,11 +139,13 @@ void ImuFusion::reanchor(const Eigen::Isometry3d& T_new_old) {
   state.v_world = T_new_old.linear() * state.v_world;
   odometer_.moveWorld(T_new_old);  // a correction is no motion
   const double tilt = (T_new_old.linear() * Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitZ()).norm();  // [rad]
+  const Time measured = velocity_measured_at_;  // the velocity is carried over, not measured
   if (tilt < 1e-9) {
     restart(state, smoother_.bias(), std::nullopt, smoother_.biasCovariance());
   } else {
     restart(state, smoother_.bias(), smoother_.gyroBiasCovariance());
   }
+  velocity_measured_at_ = measured;
 }
 
 // The biases' covariance after `gap` seconds without the IMU in the smoother: the window's, grown by the random walk
@@ -258,6 +261,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
   }
   propagator_.reset(r.state, r.bias);
   odometer_.add(r.state.t, r.state.T_world_imu.translation());
+  if ((out.match_usable && !out.degenerate) || visual) velocity_measured_at_ = r.state.t;
   out.has_imu_state = true;
   out.v_world = r.state.v_world;
   out.gyro_bias = r.bias.gyro;
@@ -307,7 +311,8 @@ std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b,
   if (!inc) return std::nullopt;
   const std::optional<imu::NavState> xa = propagator_.stateAt(a), xb = propagator_.stateAt(b);
   if (!xa || !xb) return inc;  // no prediction to hold it against (the smoother restarts)
-  std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion, travelOf(odometer_, *inc, *xa, *xb));
+  std::string d = disagreementWithImu(*inc, *xa, *xb, config_.vis_fusion, travelOf(odometer_, *inc, *xa, *xb),
+                                      toSeconds(b - velocity_measured_at_));
   if (d.empty())
     d = accelerationDisagreement(*inc, *xb, config_.preintegration.gravity, propagator_.bias().acc, config_.vis_fusion);
   if (!d.empty()) {

@@ -102,6 +102,9 @@ class ImuFusion {
   VisualMotion visual_;
   VisualWatch visual_watch_;
   PathOdometer odometer_;  // the fused states' path, for the VIS's keyframe gate
+  // [ns] the newest sweep at which the smoother's velocity was measured (a match constraining all six directions,
+  // the VO factor, the static hold) or restarted: the VIS's velocity gate widens with the time since
+  Time velocity_measured_at_ = 0;
   StaticHold hold_;        // a static start held at rest until the IMU says it moved (config.static_hold)
   bool initialized_ = false, given_up_ = false;
   Time t_start_ = 0;                  // [ns] the first sweep's stamp

@@ -23,6 +23,8 @@ std::string VisualMotionConfig::validate() const {
     if (!std::isfinite(v) || v <= 0) return fmt::format("{} must be finite and > 0, got {}", name, v);
   for (const auto& [name, v] : {std::pair<const char*, double>{"sigma_position_ratio", sigma_position_ratio},
                                 {"sigma_rotation_ratio", sigma_rotation_ratio},
+                                {"max_velocity_difference_ratio", max_velocity_difference_ratio},
+                                {"max_velocity_difference_growth", max_velocity_difference_growth},
                                 {"warmup", warmup},
                                 {"reset_after", reset_after},
                                 {"standing_speed", standing_speed},
@@ -167,7 +169,7 @@ std::optional<VisualIncrement> VisualMotion::increment(Time a, Time b, const imu
 namespace drover::pipeline {
 
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
-                                const VisualMotionConfig& config, const KeyframeTravel& travel) {
+                                const VisualMotionConfig& config, const KeyframeTravel& travel, double unmeasured_s) {
   const Eigen::Vector3d v_b_imu = b.T_world_imu.linear().transpose() * b.v_world;
   // A gap is a stall only when the robot moved over it: since the newest keyframe, or between it and the one before
   // (a lone keyframe after a stall).
@@ -179,8 +181,12 @@ std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState&
   if (gap > 0 && v_b_imu.norm() > config.standing_speed)
     return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s", gap, v_b_imu.norm());
   const double dv = (inc.v_b - v_b_imu).norm();
-  if (dv > config.max_velocity_difference)
-    return fmt::format("the VIS's velocity differs from the IMU's prediction by {:.2f} m/s", dv);
+  const double dv_max = config.max_velocity_difference + config.max_velocity_difference_ratio * v_b_imu.norm() +
+                        config.max_velocity_difference_growth * std::max(0.0, unmeasured_s);
+  if (dv > dv_max)
+    return fmt::format("the VIS's velocity differs from the IMU's prediction by {:.2f} m/s (at {:.2f} m/s, {:.1f} s "
+                       "since the LIS's velocity was measured: at most {:.2f})",
+                       dv, v_b_imu.norm(), std::max(0.0, unmeasured_s), dv_max);
   const Eigen::Vector3d dp_imu = a.T_world_imu.linear().transpose() * (b.T_world_imu.translation() -
                                                                        a.T_world_imu.translation());
   const double dp = (inc.T_a_b.translation() - dp_imu).norm();

@@ -25,7 +25,9 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
            "    sigma_position_ratio: 0.06\n    sigma_rotation: 0.02\n    sigma_rotation_ratio: 0.07\n"
            "    min_features: 25\n    full_features: 90\n    warmup: 1.5\n    max_age: 0.25\n"
            "    max_keyframe_gap: 0.6\n    standing_speed: 0.3\n    keyframe_gap_min_distance: 0.35\n"
-           "    max_velocity_difference: 1.1\n    max_acceleration_difference: 0.09\n"
+           "    max_velocity_difference: 1.1\n    max_velocity_difference_ratio: 0.07\n"
+           "    max_velocity_difference_growth: 0.04\n"
+           "    max_acceleration_difference: 0.09\n"
            "    max_position_difference: 0.45\n    reset_after: 2.5\n    window_covariance: true\n"
            "    window_floor_position: 0.007\n    window_floor_rotation: 0.003\n")
           .vis_fusion;
@@ -45,6 +47,8 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_DOUBLE_EQ(c.standing_speed, 0.3);
   EXPECT_DOUBLE_EQ(c.keyframe_gap_min_distance, 0.35);
   EXPECT_DOUBLE_EQ(c.max_velocity_difference, 1.1);
+  EXPECT_DOUBLE_EQ(c.max_velocity_difference_ratio, 0.07);
+  EXPECT_DOUBLE_EQ(c.max_velocity_difference_growth, 0.04);
   EXPECT_DOUBLE_EQ(c.max_acceleration_difference, 0.09);
   EXPECT_DOUBLE_EQ(c.max_position_difference, 0.45);
   EXPECT_DOUBLE_EQ(c.reset_after, 2.5);

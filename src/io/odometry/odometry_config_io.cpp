@@ -128,6 +128,8 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bind("standing_speed", c.standing_speed)
       .bind("keyframe_gap_min_distance", c.keyframe_gap_min_distance)
       .bind("max_velocity_difference", c.max_velocity_difference)
+      .bind("max_velocity_difference_ratio", c.max_velocity_difference_ratio)
+      .bind("max_velocity_difference_growth", c.max_velocity_difference_growth)
       .bind("max_position_difference", c.max_position_difference)
       .bind("max_acceleration_difference", c.max_acceleration_difference)
       .bindSeconds("reset_after", c.reset_after, atLeast(0, "s"));
