@@ -181,12 +181,13 @@ std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState&
   if (gap > 0 && v_b_imu.norm() > config.standing_speed)
     return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s", gap, v_b_imu.norm());
   const double dv = (inc.v_b - v_b_imu).norm();
-  const double dv_max = config.max_velocity_difference + config.max_velocity_difference_ratio * v_b_imu.norm() +
-                        config.max_velocity_difference_growth * std::max(0.0, unmeasured_s);
+  const double speed = v_b_imu.norm(), unmeasured = std::max(0.0, unmeasured_s);
+  const double dv_max = config.max_velocity_difference + config.max_velocity_difference_ratio * speed +
+                        config.max_velocity_difference_growth * unmeasured;
   if (dv > dv_max)
     return fmt::format("the VIS's velocity differs from the IMU's prediction by {:.2f} m/s (at {:.2f} m/s, {:.1f} s "
                        "since the LIS's velocity was measured: at most {:.2f})",
-                       dv, v_b_imu.norm(), std::max(0.0, unmeasured_s), dv_max);
+                       dv, speed, unmeasured, dv_max);
   const Eigen::Vector3d dp_imu = a.T_world_imu.linear().transpose() * (b.T_world_imu.translation() -
                                                                        a.T_world_imu.translation());
   const double dp = (inc.T_a_b.translation() - dp_imu).norm();

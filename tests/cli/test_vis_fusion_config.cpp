@@ -91,6 +91,10 @@ TEST(VisFusionConfigReader, BadValuesAndUnknownKeysAreErrorsNamingFileAndKey) {
   EXPECT_TRUE(has(travel, file) && has(travel, "keyframe_gap_min_distance")) << travel;
   const std::string travel_text = errorOf(dir, "odometry:\n  vis_fusion:\n    keyframe_gap_min_distance: far\n");
   EXPECT_TRUE(has(travel_text, file) && has(travel_text, "keyframe_gap_min_distance")) << travel_text;
+  const std::string ratio = errorOf(dir, "odometry:\n  vis_fusion:\n    max_velocity_difference_ratio: -0.05\n");
+  EXPECT_TRUE(has(ratio, file) && has(ratio, "max_velocity_difference_ratio")) << ratio;
+  const std::string growth = errorOf(dir, "odometry:\n  vis_fusion:\n    max_velocity_difference_growth: fast\n");
+  EXPECT_TRUE(has(growth, file) && has(growth, "max_velocity_difference_growth")) << growth;
   const std::string flag = errorOf(dir, "odometry:\n  vis_fusion:\n    window_covariance: maybe\n");
   EXPECT_TRUE(has(flag, file) && has(flag, "window_covariance")) << flag;
   const std::string unknown = errorOf(dir, "odometry:\n  vis_fusion:\n    facter: true\n");
