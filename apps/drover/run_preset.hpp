@@ -33,7 +33,8 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio);
 //   vo-factor (the VIS's motion as a factor), vis-guess (... as the matcher's guess), vis-gates (the health gates
 //   and the reset by the LIS), visual-yaw-prior (loop closure's VIS yaw), scan-context (radius loops instead),
 //   depth-factor (lidar depth held fixed instead), superpoint (Shi-Tomasi instead), lk-min-eigenvalue (SuperPoint's
-//   tracks at the platform's LK threshold), keyframe-interval (the VIS's keyframes by parallax alone, as VINS-Mono).
+//   tracks at the platform's LK threshold), keyframe-interval (the VIS's keyframes by parallax alone, as VINS-Mono),
+//   keyframe-gap-speed (every keyframe gap while moving a stall, whatever the VIS's velocity).
 std::vector<std::string> partNames();
 
 // A run's choice: the preset, then the parts taken out.

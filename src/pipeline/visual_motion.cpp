@@ -28,7 +28,8 @@ std::string VisualMotionConfig::validate() const {
                                 {"warmup", warmup},
                                 {"reset_after", reset_after},
                                 {"standing_speed", standing_speed},
-                                {"keyframe_gap_min_distance", keyframe_gap_min_distance}})
+                                {"keyframe_gap_min_distance", keyframe_gap_min_distance},
+                                {"keyframe_gap_velocity_tolerance", keyframe_gap_velocity_tolerance}})
     if (!std::isfinite(v) || v < 0) return fmt::format("{} must be finite and >= 0, got {}", name, v);
   if (min_features < 1 || full_features < min_features)
     return fmt::format("need 0 < min_features <= full_features, got {} and {}", min_features, full_features);
@@ -178,10 +179,13 @@ std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState&
   const double gap = std::max(since > config.max_keyframe_gap && travel.since_keyframe >= min_travel ? since : 0.0,
                               interval > config.max_keyframe_gap && travel.keyframe_interval >= min_travel ? interval
                                                                                                         : 0.0);
-  if (gap > 0 && v_b_imu.norm() > config.standing_speed)
-    return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s", gap, v_b_imu.norm());
   const double dv = (inc.v_b - v_b_imu).norm();
   const double speed = v_b_imu.norm(), unmeasured = std::max(0.0, unmeasured_s);
+  const bool holds_speed = config.keyframe_gap_velocity_tolerance > 0 &&
+                           dv <= config.keyframe_gap_velocity_tolerance + config.max_velocity_difference_ratio * speed;
+  if (gap > 0 && speed > config.standing_speed && !holds_speed)
+    return fmt::format("the VIS made no keyframe for {:.1f} s while moving at {:.2f} m/s (its velocity {:.2f} m/s off)",
+                       gap, speed, dv);
   const double dv_max = config.max_velocity_difference + config.max_velocity_difference_ratio * speed +
                         config.max_velocity_difference_growth * unmeasured;
   if (dv > dv_max)

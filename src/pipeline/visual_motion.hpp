@@ -71,6 +71,18 @@ struct VisualMotionConfig {
   // gap alone refused the VIS for 0.3-0.5 s (its first moving keyframe, 0.16 m on, came 1.3 s after the standing
   // one); a moving VIS keyframes every 8-11 cm at 0.8 m/s, and the white walls' stall drove 2.7 m. 0: time alone.
   double keyframe_gap_min_distance = 0.25;  // [m]
+  // ... and, when this is > 0, the VIS's velocity is more than this (plus max_velocity_difference_ratio times the
+  // predicted speed) off the IMU's prediction: a stall is a VIS that lost its translation. Leaving the farm's white
+  // walls (seed 1, 2x2 frames) the drover preset's VIS ran at 0.94-1.00 m/s at a true 1.00, on 13-19 tracks with
+  // lidar depth, but made no keyframe by parallax for up to 2.8 s (far walls ahead): refused for it, it was reset
+  // twice while the blind LIS slowed from 0.87 to 0.73 m/s. On the white-walls course the gap came with a VIS at
+  // 0.30-0.54 m/s (scale collapsed) against the LIS's 0.98. 0 (the default): every gap while moving is a stall. A VIS
+  // that coasts without seeing its translation agrees with the IMU's prediction too, and the velocity alone cannot
+  // tell it: with the platform file's SuperPoint tracks (no keyframes by time, the lower LK threshold) the corridor's
+  // textureless stretch left 26-35 tracks sliding on the wall and a window of 150 stale features, and that VIS,
+  // slowing from 0.99 to 0.79 m/s within 0.02 m/s of the LIS, took the LIS with it (0.78 -> 2.60 % drift). The drover
+  // preset sets 0.2 (apps/drover/run_preset.cpp): its LK threshold drops those tracks and the VIS resets instead.
+  double keyframe_gap_velocity_tolerance = 0;  // [m/s]
   // The VIS's velocity at the later stamp (body frame) within max_velocity_difference, plus _ratio times the
   // IMU-predicted speed (the VIS's scale error), plus _growth times the time since the LIS's velocity was last
   // measured (a match constraining all six directions, the VO factor or the static hold): what the IMU alone may
@@ -159,7 +171,8 @@ struct KeyframeTravel {
 // of their own) within config.max_velocity_difference (plus _ratio times the predicted speed, plus _growth times
 // `unmeasured_s`, the seconds since the LIS's velocity was last measured) and max_position_difference, and the VIS
 // made a keyframe within max_keyframe_gap of b (and the one before within that of it) unless the prediction stands
-// still or the LIS moved less than keyframe_gap_min_distance over the gap; else why not.
+// still, the LIS moved less than keyframe_gap_min_distance over the gap, or the VIS's velocity is within
+// keyframe_gap_velocity_tolerance (plus the ratio) of the prediction; else why not.
 std::string disagreementWithImu(const VisualIncrement& inc, const imu::NavState& a, const imu::NavState& b,
                                 const VisualMotionConfig& config, const KeyframeTravel& travel = {},
                                 double unmeasured_s = 0);

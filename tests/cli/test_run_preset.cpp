@@ -87,5 +87,23 @@ TEST(RunPreset, ThePresetsKeepThePlatformsCornerTopUpExceptForShiTomasi) {
   EXPECT_EQ(trackerAfter({Preset::kLviSam, {}}, kSuperPoint).detect_sync_below, 0);
 }
 
+// The keyframe gap's speed rule: the drover preset waives a gap while the VIS holds the IMU's speed within 0.2 m/s
+// (+ 5 %); the platform keeps every gap a stall (its VIS can coast on sliding tracks), --without keyframe-gap-speed
+// restores that in the preset, and the lvi-sam preset has no keyframe gate at all.
+pipeline::VisualMotionConfig fusionAfter(const MethodChoice& method, double platform_tolerance) {
+  pipeline::OdometryConfig odometry;
+  odometry.vis_fusion.keyframe_gap_velocity_tolerance = platform_tolerance;
+  method.apply(odometry);
+  return odometry.vis_fusion;
+}
+
+TEST(RunPreset, TheDroverPresetCountsAKeyframeGapAsAStallOnlyWhenTheVisVelocityLeftTheImus) {
+  EXPECT_DOUBLE_EQ(fusionAfter({Preset::kDrover, {}}, 0).keyframe_gap_velocity_tolerance, 0.2);
+  EXPECT_DOUBLE_EQ(fusionAfter({Preset::kDrover, {"keyframe-gap-speed"}}, 0).keyframe_gap_velocity_tolerance, 0);
+  EXPECT_DOUBLE_EQ(fusionAfter({Preset::kPlatform, {}}, 0.3).keyframe_gap_velocity_tolerance, 0.3);
+  EXPECT_DOUBLE_EQ(pipeline::VisualMotionConfig{}.keyframe_gap_velocity_tolerance, 0) << "the platform's default";
+  EXPECT_GT(fusionAfter({Preset::kLviSam, {}}, 0).max_keyframe_gap, 1e9) << "no keyframe gate";
+}
+
 }  // namespace
 }  // namespace drover::cli

@@ -25,6 +25,7 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
            "    sigma_position_ratio: 0.06\n    sigma_rotation: 0.02\n    sigma_rotation_ratio: 0.07\n"
            "    min_features: 25\n    full_features: 90\n    warmup: 1.5\n    max_age: 0.25\n"
            "    max_keyframe_gap: 0.6\n    standing_speed: 0.3\n    keyframe_gap_min_distance: 0.35\n"
+           "    keyframe_gap_velocity_tolerance: 0.15\n"
            "    max_velocity_difference: 1.1\n    max_velocity_difference_ratio: 0.07\n"
            "    max_velocity_difference_growth: 0.04\n"
            "    max_acceleration_difference: 0.09\n"
@@ -46,6 +47,7 @@ TEST(VisFusionConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_DOUBLE_EQ(c.max_keyframe_gap, 0.6);
   EXPECT_DOUBLE_EQ(c.standing_speed, 0.3);
   EXPECT_DOUBLE_EQ(c.keyframe_gap_min_distance, 0.35);
+  EXPECT_DOUBLE_EQ(c.keyframe_gap_velocity_tolerance, 0.15);
   EXPECT_DOUBLE_EQ(c.max_velocity_difference, 1.1);
   EXPECT_DOUBLE_EQ(c.max_velocity_difference_ratio, 0.07);
   EXPECT_DOUBLE_EQ(c.max_velocity_difference_growth, 0.04);
@@ -91,6 +93,8 @@ TEST(VisFusionConfigReader, BadValuesAndUnknownKeysAreErrorsNamingFileAndKey) {
   EXPECT_TRUE(has(travel, file) && has(travel, "keyframe_gap_min_distance")) << travel;
   const std::string travel_text = errorOf(dir, "odometry:\n  vis_fusion:\n    keyframe_gap_min_distance: far\n");
   EXPECT_TRUE(has(travel_text, file) && has(travel_text, "keyframe_gap_min_distance")) << travel_text;
+  const std::string tolerance = errorOf(dir, "odometry:\n  vis_fusion:\n    keyframe_gap_velocity_tolerance: -0.2\n");
+  EXPECT_TRUE(has(tolerance, file) && has(tolerance, "keyframe_gap_velocity_tolerance")) << tolerance;
   const std::string ratio = errorOf(dir, "odometry:\n  vis_fusion:\n    max_velocity_difference_ratio: -0.05\n");
   EXPECT_TRUE(has(ratio, file) && has(ratio, "max_velocity_difference_ratio")) << ratio;
   const std::string growth = errorOf(dir, "odometry:\n  vis_fusion:\n    max_velocity_difference_growth: fast\n");

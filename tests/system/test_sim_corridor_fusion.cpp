@@ -195,7 +195,10 @@ TEST(SimCorridorFusion, AVisWhoseLastKeyframeWasTakenStandingIsNotRefusedAsStall
   const test::LiveCourse course = test::simulateLiveCourse("corridor", 7, 1, true);
   const Time t0 = course.truth.front().t;
   const auto min_distance = [](double d) {
-    return [d](pipeline::OdometryConfig& c) { c.vis_fusion.keyframe_gap_min_distance = d; };
+    return [d](pipeline::OdometryConfig& c) {
+      c.vis_fusion.keyframe_gap_min_distance = d;
+      c.vis_fusion.keyframe_gap_velocity_tolerance = 0;  // the travel alone: this VIS holds the predicted speed
+    };
   };
   const FusedRun by_distance = runFused(course, t0 + 6 * kS, true, min_distance(0.25));
   const FusedRun by_time = runFused(course, t0 + 6 * kS, true, min_distance(0.0));

@@ -127,6 +127,7 @@ void bindVisFusion(YamlSection& s, pipeline::VisualMotionConfig& c) {
       .bindSeconds("max_keyframe_gap", c.max_keyframe_gap, atLeast(0, "s"))
       .bind("standing_speed", c.standing_speed)
       .bind("keyframe_gap_min_distance", c.keyframe_gap_min_distance)
+      .bind("keyframe_gap_velocity_tolerance", c.keyframe_gap_velocity_tolerance)
       .bind("max_velocity_difference", c.max_velocity_difference)
       .bind("max_velocity_difference_ratio", c.max_velocity_difference_ratio)
       .bind("max_velocity_difference_growth", c.max_velocity_difference_growth)

@@ -23,7 +23,8 @@
 //                   sigma_position_ratio [m/m], sigma_rotation [rad], sigma_rotation_ratio [rad/rad],
 //                   window_covariance (bool), window_floor_position [m], window_floor_rotation [rad], min_features,
 //                   full_features, warmup [s], max_age [s], max_keyframe_gap [s], standing_speed [m/s],
-//                   keyframe_gap_min_distance [m], max_velocity_difference [m/s],
+//                   keyframe_gap_min_distance [m], keyframe_gap_velocity_tolerance [m/s],
+//                   max_velocity_difference [m/s],
 //                   max_velocity_difference_ratio [m/s per m/s], max_velocity_difference_growth [m/s^2],
 //                   max_position_difference [m], max_acceleration_difference [m/s^2], reset_after [s]
 //                   (pipeline/visual_motion.hpp)
