@@ -277,6 +277,26 @@ TEST(VisualMotion, InvalidSettingsAreRefusedNamingTheKey) {
 
 namespace drover::pipeline {
 
+namespace {
+// Two sweeps 0.1 s apart ending at t_b, driving straight along x at lis_speed, and a VIS saying vis_speed, its last
+// keyframe keyframe_age before t_b.
+struct StraightDrive {
+  imu::NavState a, b;
+  VisualIncrement inc;
+};
+StraightDrive straightDrive(Time t_b, double lis_speed, double vis_speed, Time keyframe_age) {
+  StraightDrive d;
+  d.a = imu::NavState{t_b - kSec / 10, Eigen::Isometry3d::Identity(), Eigen::Vector3d(lis_speed, 0, 0)};
+  Eigen::Isometry3d T_b = Eigen::Isometry3d::Identity();
+  T_b.translation() = Eigen::Vector3d(lis_speed / 10, 0, 0);
+  d.b = imu::NavState{t_b, T_b, d.a.v_world};
+  d.inc.T_a_b = T_b;
+  d.inc.v_b = {vis_speed, 0, 0};
+  d.inc.last_keyframe_at = t_b - keyframe_age;
+  return d;
+}
+}  // namespace
+
 TEST(VisualMotion, AStalledOrJumpingVisIsRefusedAHealthyOrStandingOneIsKept) {
   // The LIS's prediction: 1 m/s along its body x for 0.1 s, in a world turned 90 deg (the check is frame-free).
   const Eigen::Isometry3d T_a(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()));
@@ -326,16 +346,8 @@ TEST(VisualMotion, AStalledOrJumpingVisIsRefusedAHealthyOrStandingOneIsKept) {
 TEST(VisualMotion, AVisWhoseScaleCollapsedIsRefusedByItsVelocityButOneThatCorrectsALongBlindLisIsKept) {
   const VisualMotionConfig c;  // 0.2 m/s + 5 % of the predicted speed + 0.05 m/s per s unmeasured
   const auto verdict = [&](double lis_speed, double vis_speed, double unmeasured_s) {
-    const Time t_b = 20 * kSec;
-    const imu::NavState a{t_b - kSec / 10, Eigen::Isometry3d::Identity(), Eigen::Vector3d(lis_speed, 0, 0)};
-    Eigen::Isometry3d T_b = Eigen::Isometry3d::Identity();
-    T_b.translation() = Eigen::Vector3d(lis_speed / 10, 0, 0);
-    const imu::NavState b{t_b, T_b, a.v_world};
-    VisualIncrement inc;
-    inc.T_a_b = T_b;
-    inc.v_b = {vis_speed, 0, 0};
-    inc.last_keyframe_at = t_b - kSec / 10;
-    return disagreementWithImu(inc, a, b, c, {}, unmeasured_s);
+    const StraightDrive d = straightDrive(20 * kSec, lis_speed, vis_speed, kSec / 10);
+    return disagreementWithImu(d.inc, d.a, d.b, c, {}, unmeasured_s);
   };
   // The white-walls course: SuperPoint's VIS on 20 wall tracks said 0.33 m/s at a true 1.00 (the LIS 0.99), 0.5 s
   // after the lidar last held the LIS.
@@ -408,20 +420,12 @@ TEST(VisualMotion, AKeyframeGapIsAStallOnlyWhenTheLisMovedOverIt) {
 // m/s whose scale had collapsed, the LIS at 0.98.
 TEST(VisualMotion, AKeyframeGapIsAStallOnlyWhenTheVisVelocityLeftThePrediction) {
   const auto verdict = [](double lis_speed, double vis_speed, double tolerance) {
-    const Time t_b = 280 * kSec;
-    const imu::NavState a{t_b - kSec / 10, Eigen::Isometry3d::Identity(), Eigen::Vector3d(lis_speed, 0, 0)};
-    Eigen::Isometry3d T_b = Eigen::Isometry3d::Identity();
-    T_b.translation() = Eigen::Vector3d(lis_speed / 10, 0, 0);
-    const imu::NavState b{t_b, T_b, a.v_world};
-    VisualIncrement inc;
-    inc.T_a_b = T_b;
-    inc.v_b = {vis_speed, 0, 0};
-    inc.last_keyframe_at = t_b - 2'800'000'000;
+    const StraightDrive d = straightDrive(280 * kSec, lis_speed, vis_speed, 2'800'000'000);
     VisualMotionConfig c;  // gap 0.5 s; 0.2 m/s + 5 % of the speed; unmeasured time 16 s
     c.keyframe_gap_velocity_tolerance = tolerance;
     KeyframeTravel travel;
     travel.since_keyframe = 2.4;
-    return disagreementWithImu(inc, a, b, c, travel, 16.0);
+    return disagreementWithImu(d.inc, d.a, d.b, c, travel, 16.0);
   };
   EXPECT_EQ(verdict(0.85, 0.96, 0.2), "") << "the farm's exit: 0.11 m/s off, within 0.24";
   EXPECT_EQ(verdict(0.85, 1.07, 0.2), "") << "0.22 m/s off, within 0.24";
