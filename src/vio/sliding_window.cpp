@@ -206,6 +206,16 @@ bool SlidingWindowEstimator::tryInitialize(const Seeder& seed, FrameResult& resu
   bool ok = false;
   // LVI-SAM: while the LIS runs, the VIS starts from its state; the window waits until the LIS covers it.
   if (config_.init == InitMode::kLis || (config_.init == InitMode::kAuto && seed)) {
+    if (seed && result.tracked < config_.min_tracked) {
+      // With a LIS the failure check clears a window whose newest frame tracks fewer than min_tracked features,
+      // from the frame after the initialisation on (failure()): initialising on fewer only starts the next reset.
+      // On the farm's white walls and a covered camera that was an initialisation and a reset every 0.8 s.
+      why = fmt::format("only {} features tracked into the newest frame (< min_tracked {})", result.tracked,
+                        config_.min_tracked);
+      waiting_for_older_ = false;
+      result.event = "not initialised: " + why;
+      return false;
+    }
     ok = initializeFromSeed(seed, why);
     if (ok) result.event = "initialised from the LIS (" + why + ")";
     // Frames older than the LIS's first state can never be seeded: let the oldest go.
