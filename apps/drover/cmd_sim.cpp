@@ -18,6 +18,7 @@
 #include "apps/drover/checked_options.hpp"
 #include "apps/drover/commands.hpp"
 #include "io/error.hpp"
+#include "io/euroc_writer.hpp"
 #include "io/sim_bag.hpp"
 #include "io/sim_dataset.hpp"
 #include "io/trajectory_io.hpp"
@@ -89,9 +90,9 @@ Trajectory loadKitti05(const SimOptions& o) {
 }
 
 sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
-  sim::SimulatorConfig c = sim::SimulatorConfig::defaults();
   io::SimConfigSettings s;
   if (!o.config.empty()) s = io::loadSimConfigSettings(o.config);
+  sim::SimulatorConfig c = s.rig == "euroc" ? sim::SimulatorConfig::eurocRig() : sim::SimulatorConfig::defaults();
   c.lidar = sim::LidarModelConfig::forModel(!o.lidar.empty() ? o.lidar : s.lidar_model.value_or("vlp16"));
   if (s.lidar_rate_hz) c.lidar.rate_hz = *s.lidar_rate_hz;
   if (s.lidar_columns) c.lidar.columns = *s.lidar_columns;
@@ -105,6 +106,9 @@ sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
   if (s.camera_time_offset_s) c.camera_time_offset = fromSeconds(*s.camera_time_offset_s);
   if (s.noise && !*s.noise) c.lidar.noise = c.camera.noise = c.imu.noise = false;
   c.enable_camera = !o.no_camera;
+  if (o.format == "euroc") c.enable_lidar = false;  // EuRoC's layout has no lidar
+  if (!o.lidar.empty() && !c.enable_lidar)
+    throw std::invalid_argument("--lidar: this rig or format has no lidar (EuRoC's camera + IMU)");
   c.faults = o.faults;
   if (std::string e = c.validate(); !e.empty()) throw std::invalid_argument("simulator settings: " + e);
   return c;
@@ -118,6 +122,7 @@ void checkOptions(const SimOptions& o) {
   // Before any simulation: --force replaces only an earlier dataset (or an empty folder), never ".", "..", the
   // home folder or a file; with --format bag only an earlier bag, never a folder or another file.
   if (o.format == "bag") return io::SimBagWriter::checkOutput(o.out, o.force);
+  if (o.format == "euroc") return io::EurocDatasetWriter::checkOutput(o.out, o.force);
   io::SimWriterOptions wo;
   wo.overwrite = o.force;
   io::SimDatasetWriter::checkOutput(o.out, wo);
@@ -158,6 +163,35 @@ void writeBag(const SimOptions& o, const sim::Simulator& simulator, Progress& pr
                c.ground_truth, mb, mb / std::max(1e-9, sim_s), sim_s, wall, sim_s / std::max(1e-9, wall));
 }
 
+// EuRoC's ground truth: the pose, the velocity in the world and the IMU's true biases at each stamp.
+std::vector<io::EurocTruthState> eurocTruth(const sim::Simulator& simulator) {
+  const std::vector<sim::ImuBiasSample> biases = simulator.imuBiases();
+  std::vector<io::EurocTruthState> truth;
+  std::size_t b = 0;
+  for (const io::SimGroundTruthState& g : simulator.groundTruthStates()) {
+    while (b + 1 < biases.size() && biases[b + 1].t <= g.t) ++b;  // the bias of the newest IMU sample
+    io::EurocTruthState s;
+    s.t = g.t;
+    s.T_world_imu = g.T_world_imu;
+    s.v_world = g.T_world_imu.linear() * g.v_imu;
+    if (!biases.empty()) s.gyro_bias = biases[b].gyro, s.accel_bias = biases[b].accel;
+    truth.push_back(s);
+  }
+  return truth;
+}
+
+void writeEuroc(const SimOptions& o, const sim::Simulator& simulator, Progress& progress, double sim_s) {
+  io::EurocDatasetWriter writer(o.out, simulator.datasetDescription(), o.force);
+  simulator.run([&](Measurement&& m) {
+    progress.update(measurementTime(m));
+    writer.add(std::move(m));
+  });
+  writer.finish(eurocTruth(simulator));
+  const double wall = progress.wallSeconds();
+  spdlog::info("wrote {} (EuRoC layout): {} IMU samples, {} frames; {:.1f} s simulated in {:.1f} s ({:.2f} sim-s/s)",
+               o.out, writer.imuCount(), writer.frameCount(), sim_s, wall, sim_s / std::max(1e-9, wall));
+}
+
 void runSim(const SimOptions& o) {
   if (o.quiet) spdlog::set_level(spdlog::level::err);
   checkOptions(o);
@@ -189,6 +223,7 @@ void runSim(const SimOptions& o) {
   Progress progress(scenario.trajectory->startTime(), scenario.trajectory->endTime());
   const double sim_s = toSeconds(scenario.trajectory->endTime() - scenario.trajectory->startTime());
   if (o.format == "bag") return writeBag(o, simulator, progress, sim_s);
+  if (o.format == "euroc") return writeEuroc(o, simulator, progress, sim_s);
   io::SimWriterOptions wo;
   wo.overwrite = o.force;
   io::SimDatasetWriter writer(o.out, simulator.datasetDescription(), wo);
@@ -230,8 +265,9 @@ void registerSim(CLI::App& app) {
   cmd->add_option("--format", o->format,
                   "Output format: folder (Drover's layout), or bag: a ROS1 bag with LVI-SAM's topics /points_raw, "
                   "/imu_raw, /camera/image_raw and the ground truth on /ground_truth (nav_msgs/Odometry of the IMU); "
-                  "read it with --config config/farm_sim_bag.yaml")
-      ->check(CLI::IsMember({"folder", "bag"}))
+                  "read it with --config config/farm_sim_bag.yaml; or euroc: EuRoC MAV's folder layout (camera + "
+                  "IMU, no lidar), read with --format euroc")
+      ->check(CLI::IsMember({"folder", "bag", "euroc"}))
       ->capture_default_str();
   cmd->add_option("--config", o->config, "Platform config with a sim: section (config/farm_sim.yaml)");
   cmd->add_option("--kitti-poses", o->kitti_poses, "kitti05-replay: KITTI poses file (default ../shared/data)");

@@ -44,7 +44,12 @@ bool boolean(const YAML::Node& n, const std::string& key, const std::string& fil
 }
 
 void readKey(const YAML::Node& n, const std::string& key, const std::string& file, SimConfigSettings& s) {
-  if (key == "lidar_model") {
+  if (key == "rig") {
+    const std::string r = scalar(n, key, file);
+    if (r != "robot" && r != "euroc")
+      fail(file, keyRecord(n, key), "unknown rig " + echo(r) + " (expected robot or euroc)");
+    s.rig = r;
+  } else if (key == "lidar_model") {
     const std::string m = scalar(n, key, file);
     if (m != "vlp16" && m != "vlp32" && m != "hdl64")
       fail(file, keyRecord(n, key), "unknown lidar " + echo(m) + " (expected vlp16, vlp32 or hdl64)");
@@ -88,7 +93,7 @@ SimConfigSettings loadSimConfigSettings(const std::string& yaml_path) {
   static const std::vector<std::string> known = {
       "lidar_model",    "lidar_rate_hz", "lidar_columns",        "camera_rate_hz",    "camera_color",
       "imu_rate_hz",    "noise",         "ground_truth_rate_hz", "lidar_time_offset", "camera_time_offset",
-      "camera_pixel_samples"};
+      "camera_pixel_samples", "rig"};
   for (const auto& kv : sim) {
     const std::string key = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), key) == known.end()) {

@@ -199,6 +199,9 @@ constexpr double kMaxSimGroundTruthRateHz = 1000;  // [Hz]
 constexpr double kMaxSimTimeOffsetS = 1;       // [s] |lidar_time_offset|, |camera_time_offset|
 
 struct SimConfigSettings {
+  // robot: the farm robot's rig (sim::SimulatorConfig::defaults()); euroc: EuRoC's MAV (camera + IMU, no lidar;
+  // sim::SimulatorConfig::eurocRig()). The keys below change either.
+  std::optional<std::string> rig;
   std::optional<std::string> lidar_model;        // vlp16 | vlp32 | hdl64
   std::optional<double> lidar_rate_hz;           // [Hz]
   std::optional<int> lidar_columns;              // firings per revolution

@@ -44,7 +44,8 @@ std::string ImuModelConfig::validate() const {
 }
 
 std::vector<ImuSample> simulateImu(const SplineTrajectory& trajectory, const ImuModelConfig& config,
-                                   std::uint64_t seed) {
+                                   std::uint64_t seed, const Eigen::Matrix3d& R_body_imu,
+                                   std::vector<ImuBiasSample>* biases) {
   if (const std::string error = config.validate(); !error.empty())
     throw std::invalid_argument("simulateImu: invalid ImuModelConfig: " + error);
   // Kalibr IMU noise model: discrete white-noise sigma_d = sigma / sqrt(dt), bias random-walk step
@@ -56,6 +57,7 @@ std::vector<ImuSample> simulateImu(const SplineTrajectory& trajectory, const Imu
   const double sigma_ba = config.accel_bias_random_walk * std::sqrt(dt);
   const Eigen::Vector3d g_world(0.0, 0.0, -config.gravity);
 
+  const bool body_is_imu = R_body_imu == Eigen::Matrix3d::Identity();
   Eigen::Vector3d b_g = config.noise ? config.initial_gyro_bias : Eigen::Vector3d::Zero();
   Eigen::Vector3d b_a = config.noise ? config.initial_accel_bias : Eigen::Vector3d::Zero();
   std::vector<ImuSample> out;
@@ -65,11 +67,16 @@ std::vector<ImuSample> simulateImu(const SplineTrajectory& trajectory, const Imu
     const Time t = start + static_cast<Time>(std::llround(static_cast<double>(k) * 1e9 / config.rate_hz));
     if (t > end) break;
     const BodyState s = trajectory.at(t);
-    const Eigen::Matrix3d R_world_imu = s.T_world_body.linear();
+    Eigen::Matrix3d R_world_imu = s.T_world_body.linear();
     ImuSample m;
     m.t = t;
     m.omega_imu = s.omega_body;
     m.acc_imu = R_world_imu.transpose() * (s.a_world - g_world);  // specific force
+    if (!body_is_imu) {  // skipped for the identity, so ground rigs keep their exact bits
+      m.omega_imu = R_body_imu.transpose() * m.omega_imu;
+      m.acc_imu = R_body_imu.transpose() * m.acc_imu;
+      R_world_imu = R_world_imu * R_body_imu;
+    }
     if (config.noise) {
       if (k > 0) {  // the biases walk between samples; sample 0 carries the initial biases
         b_g += sigma_bg * normal3(seed, k, kGyroWalk);
@@ -79,6 +86,7 @@ std::vector<ImuSample> simulateImu(const SplineTrajectory& trajectory, const Imu
       m.acc_imu += b_a + sigma_a * normal3(seed, k, kAccelNoise);
     }
     if (config.orientation) m.q_world_imu = Eigen::Quaterniond(R_world_imu).normalized();
+    if (biases != nullptr) biases->push_back({t, b_g, b_a});
     out.push_back(m);
   }
   return out;

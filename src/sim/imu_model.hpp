@@ -36,7 +36,18 @@ struct ImuModelConfig {
 // noise, 3..5 accel noise, 6..8 gyro bias step, 9..11 accel bias step, so output is a pure function of the
 // seed. q_world_imu is the exact R_world_body when config.orientation. Throws std::invalid_argument when
 // config.validate() fails.
+// The biases the model walked, at every sample's stamp, in the IMU's frame (a dataset's ground truth).
+struct ImuBiasSample {
+  Time t = 0;                                          // [ns]
+  Eigen::Vector3d gyro = Eigen::Vector3d::Zero();      // [rad/s]
+  Eigen::Vector3d accel = Eigen::Vector3d::Zero();     // [m/s^2]
+};
+
+// R_body_imu: the IMU's axes in the trajectory's body frame (columns); the measurements, the biases and the noise
+// are in the IMU's frame, q_world_imu = R_world_body R_body_imu. Identity: the IMU is the body (every ground rig).
 std::vector<ImuSample> simulateImu(const SplineTrajectory& trajectory, const ImuModelConfig& config,
-                                   std::uint64_t seed);
+                                   std::uint64_t seed,
+                                   const Eigen::Matrix3d& R_body_imu = Eigen::Matrix3d::Identity(),
+                                   std::vector<ImuBiasSample>* biases = nullptr);
 
 }  // namespace drover::sim

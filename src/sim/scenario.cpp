@@ -39,7 +39,7 @@ std::string conditionName(Condition c) {
 
 std::vector<std::string> scenarioNames() {
   return {"uphill",      "downhill",    "garage-exit", "garage-entry", "jolting", "straight",      "overlap",
-          "sharp-turns", "white-walls", "corridor",    "lighting",     "farm",    "kitti05-replay"};
+          "sharp-turns", "white-walls", "corridor",    "lighting",     "farm",    "kitti05-replay", "mav-room"};
 }
 
 namespace {
@@ -79,6 +79,7 @@ Scenario makeScenario(const std::string& name, const ScenarioOptions& options) {
       throw std::invalid_argument("makeScenario: kitti05-replay needs options.kitti05_ground_truth (KITTI poses 05)");
     return detail::makeKittiReplay(*options.kitti05_ground_truth, options);
   }
+  if (name == "mav-room") return detail::makeMavRoom(options);
   const std::vector<std::string> names = scenarioNames();
   if (std::find(names.begin(), names.end(), name) == names.end())
     throw std::invalid_argument("makeScenario: unknown scenario '" + name + "'; known: " + knownNames());

@@ -48,7 +48,8 @@ struct ScenarioOptions {
 
 // Names: uphill, downhill, garage-exit, garage-entry, jolting, straight, overlap, sharp-turns (each condition
 // alone), white-walls, corridor, lighting (each degradation alone), farm (the ~600 m closed course through all of
-// them at 0..1.2 m/s) and kitti05-replay. Throws std::invalid_argument for an unknown name (listing the known ones)
+// them at 0..1.2 m/s), kitti05-replay and mav-room (a micro aerial vehicle flying 100 s in a textured room, EuRoC's
+// Vicon-room class of motion, for the rig of SimulatorConfig::eurocRig(); scenario_mav.cpp). Throws std::invalid_argument for an unknown name (listing the known ones)
 // or kitti05-replay without ground truth.
 //
 // Course scenarios (farm and the single conditions): the path is built from straights, arcs and ramps (10 % grade,

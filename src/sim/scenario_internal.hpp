@@ -27,6 +27,8 @@ std::vector<Segment> revisitSegments(const std::vector<PathSample>& samples, dou
                                      double min_gap_s = 30.0);
 
 Scenario makeKittiReplay(const Trajectory& ground_truth, const ScenarioOptions& options);
+// A micro aerial vehicle's flight in a textured room (scenario_mav.cpp).
+Scenario makeMavRoom(const ScenarioOptions& options);
 // Facades, trees, parked cars and asphalt along the path (body = camera 0, kKittiCameraHeight above the road).
 World buildTown(const std::vector<PathSample>& samples, std::uint64_t seed);
 

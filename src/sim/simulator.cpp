@@ -76,6 +76,46 @@ SimulatorConfig SimulatorConfig::defaults() {
   return c;
 }
 
+SimulatorConfig SimulatorConfig::eurocRig() {
+  SimulatorConfig c;
+  c.enable_lidar = false;
+  CameraIntrinsics& k = c.camera.intrinsics;  // mav0/cam0/sensor.yaml
+  k.width = 752;
+  k.height = 480;
+  k.fx = 458.654;
+  k.fy = 457.296;
+  k.cx = 367.215;
+  k.cy = 248.375;
+  k.distortion = DistortionModel::kRadialTangential;
+  k.distortion_coeffs = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
+  c.camera.rate_hz = 20.0;
+  c.imu.rate_hz = 200.0;  // mav0/imu0/sensor.yaml
+  c.imu.gyro_noise_density = 1.6968e-04;
+  c.imu.gyro_bias_random_walk = 1.9393e-05;
+  c.imu.accel_noise_density = 2.0e-3;
+  c.imu.accel_bias_random_walk = 3.0e-3;
+  c.imu.orientation = false;  // a bare IMU: no orientation estimate
+  // The shared V1_01 snippet's IMU at rest reads (-0.002, 0.019, 0.078) rad/s; accelerometer biases of ~0.1 m/s^2.
+  c.imu.initial_gyro_bias = Eigen::Vector3d(-0.002, 0.019, 0.078);
+  c.imu.initial_accel_bias = Eigen::Vector3d(-0.02, 0.12, 0.075);
+  // EuRoC's IMU axes in the body frame: x up (body z), y right (-body y), z forward (body x).
+  c.R_body_imu << 0, 0, 1,  //
+      0, -1, 0,             //
+      1, 0, 0;
+  Eigen::Matrix4d T_BS;  // mav0/cam0/sensor.yaml: cam0 -> IMU (EuRoC's body frame B is the IMU's)
+  T_BS << 0.0148655429818, -0.999880929698, 0.00414029679422, -0.0216401454975,  //
+      0.999557249008, 0.0149672133247, 0.025715529948, -0.064676986768,          //
+      -0.0257744366974, 0.00375618835797, 0.999660727178, 0.00981073058949,      //
+      0.0, 0.0, 0.0, 1.0;
+  // Calibrated, so orthonormal only to ~1e-9: re-orthonormalised to pass as a rigid transform.
+  const Eigen::Quaterniond q(Eigen::Matrix3d(T_BS.topLeftCorner<3, 3>()));
+  c.T_imu_cam = Eigen::Isometry3d::Identity();
+  c.T_imu_cam.linear() = q.normalized().toRotationMatrix();
+  c.T_imu_cam.translation() = T_BS.topRightCorner<3, 1>();
+  c.camera_time_offset = 0;
+  return c;
+}
+
 std::string SimulatorConfig::validate() const {
   std::ostringstream e;
   if (!enable_imu && !enable_lidar && !enable_camera) return "at least one sensor must be enabled";
@@ -91,6 +131,8 @@ std::string SimulatorConfig::validate() const {
     e << "T_imu_lidar is not a rigid transform";
   } else if (!isRigid(T_imu_cam)) {
     e << "T_imu_cam is not a rigid transform";
+  } else if (Eigen::Isometry3d R = Eigen::Isometry3d(R_body_imu); !isRigid(R)) {
+    e << "R_body_imu is not a rotation";
   } else if (std::string f = validateFaults(faults); !f.empty()) {
     e << f;
   } else if (std::abs(lidar_time_offset) > kNanosPerSecond || std::abs(camera_time_offset) > kNanosPerSecond) {
@@ -106,6 +148,19 @@ Simulator::Simulator(const Scenario& scenario, const SimulatorConfig& config, st
   if (!scenario.trajectory) throw std::invalid_argument("scenario '" + scenario.name + "' has no trajectory");
 }
 
+Eigen::Isometry3d Simulator::bodyFrom(const Eigen::Isometry3d& T_imu_sensor) const {
+  if (config_.R_body_imu == Eigen::Matrix3d::Identity()) return T_imu_sensor;  // the same bits on ground rigs
+  return Eigen::Isometry3d(config_.R_body_imu) * T_imu_sensor;
+}
+
+std::vector<ImuBiasSample> Simulator::imuBiases() const {
+  std::vector<ImuBiasSample> biases;
+  if (config_.enable_imu)
+    simulateImu(*scenario_.trajectory, config_.imu, hashKeys(seed_, static_cast<std::uint64_t>(Stream::kImu)),
+                config_.R_body_imu, &biases);
+  return biases;
+}
+
 Calibration Simulator::calibration() const {
   Calibration c;
   c.T_imu_lidar = config_.T_imu_lidar;
@@ -116,13 +171,21 @@ Calibration Simulator::calibration() const {
   return c;
 }
 
-Trajectory Simulator::groundTruth() const { return scenario_.trajectory->sample(config_.ground_truth_rate_hz); }
+Trajectory Simulator::groundTruth() const {
+  Trajectory truth = scenario_.trajectory->sample(config_.ground_truth_rate_hz);
+  if (config_.R_body_imu != Eigen::Matrix3d::Identity())
+    for (StampedPose& p : truth) p.T_world_body.linear() = p.T_world_body.linear() * config_.R_body_imu;
+  return truth;
+}
 
 std::vector<io::SimGroundTruthState> Simulator::groundTruthStates() const {
   std::vector<io::SimGroundTruthState> out;
+  const bool body_is_imu = config_.R_body_imu == Eigen::Matrix3d::Identity();
   for (const StampedPose& p : groundTruth()) {
     const BodyState b = scenario_.trajectory->at(p.t);
-    out.push_back({p.t, p.T_world_body, b.T_world_body.linear().transpose() * b.v_world, b.omega_body});
+    Eigen::Vector3d v = b.T_world_body.linear().transpose() * b.v_world, w = b.omega_body;
+    if (!body_is_imu) v = config_.R_body_imu.transpose() * v, w = config_.R_body_imu.transpose() * w;
+    out.push_back({p.t, p.T_world_body, v, w});
   }
   return out;
 }
@@ -181,7 +244,8 @@ void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) 
   const std::uint64_t camera_seed = hashKeys(seed_, static_cast<std::uint64_t>(Stream::kCamera));
 
   std::vector<ImuSample> imu;
-  if (config_.enable_imu) imu = simulateImu(trajectory, config_.imu, imu_seed);
+  if (config_.enable_imu) imu = simulateImu(trajectory, config_.imu, imu_seed, config_.R_body_imu);
+  const Eigen::Isometry3d T_body_lidar = bodyFrom(config_.T_imu_lidar), T_body_cam = bodyFrom(config_.T_imu_cam);
   const std::vector<Time> sweeps = sweepStarts();
   const std::vector<Time> frames = frameTimes();
   // The camera runs in frame order (its auto exposure meters each frame for the next); sweeps run in parallel.
@@ -197,7 +261,7 @@ void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) 
     return false;
   });
   const auto sweep = [&](const Slot& s) -> Measurement {
-    LidarScan scan = simulateSweep(scenario_.world, trajectory, config_.T_imu_lidar, sweeps[s.index], config_.lidar,
+    LidarScan scan = simulateSweep(scenario_.world, trajectory, T_body_lidar, sweeps[s.index], config_.lidar,
                                    lidar_seed, s.index);
     const Time duration = scan.t_end - scan.t;
     scan.t = s.stamp;
@@ -208,7 +272,7 @@ void Simulator::run(const std::function<void(Measurement&&)>& sink, Time chunk) 
     const Time t = frames[s.index];
     const FrameCondition condition{faulted(config_.faults, FaultKind::kCameraBlackout, t),
                                    faulted(config_.faults, FaultKind::kTextureless, t)};
-    CameraFrame f = camera->next(scenario_.world, trajectory, config_.T_imu_cam, scenario_.illumination, t,
+    CameraFrame f = camera->next(scenario_.world, trajectory, T_body_cam, scenario_.illumination, t,
                                  camera_seed, s.index, condition);
     f.t = s.stamp;
     return f;

@@ -37,6 +37,9 @@ struct SimulatorConfig {
   // A default-constructed config keeps identities.
   Eigen::Isometry3d T_imu_lidar = Eigen::Isometry3d::Identity();
   Eigen::Isometry3d T_imu_cam = Eigen::Isometry3d::Identity();
+  // The IMU's axes in the trajectory's body frame (x forward, y left, z up), at its origin: identity on every ground
+  // rig (the IMU is the body). The IMU's samples, the calibration and the ground truth are all of the IMU's frame.
+  Eigen::Matrix3d R_body_imu = Eigen::Matrix3d::Identity();
   // t_imu = t_sensor + offset [ns] (as Calibration): a sensor's stamp is t_true - offset. The IMU is the clock.
   Time lidar_time_offset = 0;    // [ns]
   Time camera_time_offset = 0;   // [ns]; defaults() sets 5 ms (camera stamps 5 ms early)
@@ -45,6 +48,12 @@ struct SimulatorConfig {
   std::vector<SensorFault> faults;
   // The above with the robot's default extrinsics, offsets and camera intrinsics filled in.
   static SimulatorConfig defaults();
+  // EuRoC's MAV rig (Burri et al., IJRR 2016; the dataset's own sensor.yaml files): no lidar; cam0, an MT9V034
+  // global shutter, 752x480 mono at 20 Hz hardware-synchronised with the IMU (no time offset), its intrinsics,
+  // distortion and T_BS; the ADIS16448 IMU at 200 Hz with the noise densities and random walks of imu0/sensor.yaml
+  // and turn-on biases of the size V1_01's ground truth estimates; the IMU's axes as EuRoC's (x up, y right,
+  // z forward when level). For the mav-room scenario and `drover sim --format euroc`.
+  static SimulatorConfig eurocRig();
   std::string validate() const;  // empty when valid, else names the bad value
 };
 
@@ -57,6 +66,8 @@ class Simulator {
   Trajectory groundTruth() const;  // T_world_imu at ground_truth_rate_hz
   // The same samples with the exact twist (velocity and angular rate in the IMU frame), for nav_msgs/Odometry.
   std::vector<io::SimGroundTruthState> groundTruthStates() const;
+  // The IMU's true biases at its stamps (before any fault's gap), for a ground truth that carries them (EuRoC's).
+  std::vector<ImuBiasSample> imuBiases() const;
   // Generates everything in time order of the stamps (ties: IMU, then lidar, then camera). IMU samples come from
   // simulateImu over the whole trajectory; sweep k starts at start + k / lidar rate while its end is inside the
   // trajectory; frame k is exposed (mid-exposure) at start + exposure / 2 + k / camera rate while the exposure
@@ -76,6 +87,7 @@ class Simulator {
   std::vector<Time> sweepStarts() const;  // true start times [ns]
   std::vector<Time> frameTimes() const;   // true mid-exposure times [ns]
   bool sweepDropped(Time t0) const;        // a lidar-dropout overlaps the sweep starting (true time) at t0
+  Eigen::Isometry3d bodyFrom(const Eigen::Isometry3d& T_imu_sensor) const;  // T_body_sensor
 
   const Scenario& scenario_;
   SimulatorConfig config_;

@@ -13,6 +13,7 @@
 
 #include "io/trajectory_io.hpp"
 #include "support/cli.hpp"
+#include "support/edited_config.hpp"
 #include "support/shared_data.hpp"
 #include "support/temp_dir.hpp"
 
@@ -22,23 +23,6 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 // A platform config with the Shi-Tomasi detector (SuperPoint costs ~0.4 s a frame on these cores).
-// The shipped config `name` with each `from` replaced by its `to`, written into `dir`.
-std::string editedConfig(const std::string& name, const fs::path& dir,
-                         const std::vector<std::pair<std::string, std::string>>& edits) {
-  std::ifstream in(std::string(DROVER_SOURCE_DIR) + "/config/" + name);
-  std::stringstream text;
-  text << in.rdbuf();
-  std::string yaml = text.str();
-  for (const auto& [from, to] : edits) {
-    const auto at = yaml.find(from);
-    EXPECT_NE(at, std::string::npos) << name << " no longer has '" << from << "'";
-    if (at != std::string::npos) yaml.replace(at, from.size(), to);
-  }
-  const fs::path out = dir / name;
-  writeText(out, yaml);
-  return out.string();
-}
-
 std::string shiTomasiConfig(const std::string& name, const fs::path& dir) {
   return editedConfig(name, dir, {{"type: superpoint ", "type: shi-tomasi "}});
 }

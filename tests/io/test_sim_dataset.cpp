@@ -404,6 +404,15 @@ TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
   expectIoError([&] { loadSimConfigSettings((tmp / "b.yaml").string()); }, {"b.yaml", "line 2", "sim.lidar_modle"});
   test::writeText(tmp / "c.yaml", "sim:\n  lidar_model: vlp17\n");
   expectIoError([&] { loadSimConfigSettings((tmp / "c.yaml").string()); }, {"c.yaml", "vlp17"});
+  test::writeText(tmp / "d.yaml", "sim:\n  rig: drone\n");
+  expectIoError([&] { loadSimConfigSettings((tmp / "d.yaml").string()); }, {"d.yaml", "sim.rig", "robot or euroc"});
+}
+
+TEST(SimConfigSettings, EurocConfigSimulatesOnEurocsRigAndTheFarmsOnTheRobots) {
+  const std::string euroc = std::string(DROVER_SOURCE_DIR) + "/config/euroc.yaml";
+  EXPECT_NO_THROW(loadDatasetOptions(euroc));
+  EXPECT_EQ(loadSimConfigSettings(euroc).rig, "euroc");
+  EXPECT_FALSE(loadSimConfigSettings(std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml").rig.has_value());
 }
 
 TEST(SimConfigSettings, RatesAndOffsetsShareTheOptionsRanges) {
