@@ -16,17 +16,8 @@ namespace fs = std::filesystem;
 
 constexpr const char* kScenarioFile = "scenario.json";
 
-std::string numberList(const std::vector<double>& values) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < values.size(); ++i) s += (i ? ", " : "") + formatDouble(values[i]);
-  return s + "]";
-}
-
 std::string tbsYaml(const Eigen::Isometry3d& T) {
-  std::vector<double> v;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) v.push_back(T.matrix()(r, c));
-  return "T_BS:\n  cols: 4\n  rows: 4\n  data: " + numberList(v) + "\n";
+  return "T_BS:\n  cols: 4\n  rows: 4\n  data: " + formatRowMajor(T) + "\n";
 }
 
 std::string imuYaml(const SimSensorInfo& s) {
@@ -49,11 +40,11 @@ std::string cameraYaml(const SimDatasetDescription& d) {
   y += "rate_hz: " + formatDouble(d.sensors.camera_rate_hz) + "\n";
   y += "resolution: [" + std::to_string(k.width) + ", " + std::to_string(k.height) + "]\n";
   y += "camera_model: pinhole\n";
-  y += "intrinsics: " + numberList({k.fx, k.fy, k.cx, k.cy}) + " #fu, fv, cu, cv\n";
+  y += "intrinsics: " + formatNumberList({k.fx, k.fy, k.cx, k.cy}) + " #fu, fv, cu, cv\n";
   y += "distortion_model: radial-tangential\n";
   std::vector<double> coeffs = k.distortion_coeffs;
   if (k.distortion == DistortionModel::kNone) coeffs = {0, 0, 0, 0};
-  y += "distortion_coefficients: " + numberList(coeffs) + "\n";
+  y += "distortion_coefficients: " + formatNumberList(coeffs) + "\n";
   return y;
 }
 

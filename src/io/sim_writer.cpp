@@ -19,27 +19,14 @@ namespace fs = std::filesystem;
 
 static_assert(std::endian::native == std::endian::little, "the .bin records are written in host order");
 
-std::string numberList(const std::vector<double>& values) {
-  std::string s = "[";
-  for (std::size_t i = 0; i < values.size(); ++i) s += (i ? ", " : "") + formatDouble(values[i]);
-  return s + "]";
-}
-
-std::string rowMajor(const Eigen::Isometry3d& T) {
-  std::vector<double> v;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) v.push_back(T.matrix()(r, c));
-  return numberList(v);
-}
-
 std::string calibrationYaml(const SimDatasetDescription& d) {
   const Calibration& c = d.calibration;
   const CameraIntrinsics& k = c.camera;
   const SimSensorInfo& s = d.sensors;
   std::string y = "# Drover simulated dataset: calibration and sensor settings (format: src/io/sim_dataset.hpp).\n";
   y += "calibration:\n";
-  y += "  T_imu_lidar: " + rowMajor(c.T_imu_lidar) + "  # row-major 4x4, lidar -> IMU [m]\n";
-  y += "  T_imu_cam: " + rowMajor(c.T_imu_cam) + "  # row-major 4x4, camera -> IMU [m]\n";
+  y += "  T_imu_lidar: " + formatRowMajor(c.T_imu_lidar) + "  # row-major 4x4, lidar -> IMU [m]\n";
+  y += "  T_imu_cam: " + formatRowMajor(c.T_imu_cam) + "  # row-major 4x4, camera -> IMU [m]\n";
   y += "  lidar_time_offset: " + formatSeconds(c.lidar_time_offset) + "  # [s], t_imu = t_lidar + offset\n";
   y += "  camera_time_offset: " + formatSeconds(c.camera_time_offset) + "  # [s], t_imu = t_camera + offset\n";
   y += "  camera:\n";
@@ -48,7 +35,7 @@ std::string calibrationYaml(const SimDatasetDescription& d) {
   y += "    fx: " + formatDouble(k.fx) + "  # [px]\n    fy: " + formatDouble(k.fy) + "  # [px]\n";
   y += "    cx: " + formatDouble(k.cx) + "  # [px]\n    cy: " + formatDouble(k.cy) + "  # [px]\n";
   y += std::string("    distortion_model: ") + distortionModelName(k.distortion) + "\n";
-  y += "    distortion_coeffs: " + numberList(k.distortion_coeffs) + "\n";
+  y += "    distortion_coeffs: " + formatNumberList(k.distortion_coeffs) + "\n";
   y += "sensors:\n";
   y += "  lidar:\n    model: " + s.lidar_model + "\n    rings: " + std::to_string(s.lidar_rings) +
        "\n    columns: " + std::to_string(s.lidar_columns) + "  # firings per revolution\n    rate_hz: " +

@@ -203,6 +203,19 @@ std::string formatDouble(double value) {
   return ec == std::errc() ? std::string(buf, ptr) : std::string("nan");
 }
 
+std::string formatNumberList(const std::vector<double>& values) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) s += (i ? ", " : "") + formatDouble(values[i]);
+  return s + "]";
+}
+
+std::string formatRowMajor(const Eigen::Isometry3d& T) {
+  std::vector<double> v;
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 4; ++c) v.push_back(T.matrix()(r, c));
+  return formatNumberList(v);
+}
+
 std::string formatSeconds(Time t) {
   const bool negative = t < 0;
   // Work on the magnitude in unsigned arithmetic so INT64_MIN cannot overflow.

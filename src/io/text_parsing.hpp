@@ -80,6 +80,10 @@ std::string staleStampNotice(Time previous, Time t, const std::string& file, con
 // Shortest text that reads back to exactly the same double (std::to_chars); "nan"/"inf" never reach files
 // because writers validate first.
 std::string formatDouble(double value);
+// A YAML flow sequence of formatDouble()s: "[1, -0.5, 3e-05]".
+std::string formatNumberList(const std::vector<double>& values);
+// The 16 entries of a 4x4 transform, row after row, as formatNumberList (EuRoC's T_BS data, calibration.yaml).
+std::string formatRowMajor(const Eigen::Isometry3d& T);
 // Nanoseconds as seconds with exactly 9 decimals ("-0.000000001", "1403715274.302142977").
 std::string formatSeconds(Time t);
 
