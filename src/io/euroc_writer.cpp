@@ -62,9 +62,7 @@ std::string scenarioJson(const SimScenarioInfo& s, const SimSensorInfo& sensors)
 }
 
 std::string truthLine(const EurocTruthState& s) {
-  Eigen::Quaterniond q(s.T_world_imu.linear());
-  q.normalize();
-  if (q.w() < 0) q.coeffs() = -q.coeffs();  // q and -q are the same rotation: the one with w >= 0
+  const Eigen::Quaterniond q = canonicalQuaternion(s.T_world_imu.linear());
   const Eigen::Vector3d& p = s.T_world_imu.translation();
   std::string line = std::to_string(s.t);
   for (double v : {p.x(), p.y(), p.z(), q.w(), q.x(), q.y(), q.z(), s.v_world.x(), s.v_world.y(), s.v_world.z(),

@@ -132,13 +132,13 @@ Trajectory readTrajectory(const std::string& path, TrajectoryFormat format,
   throw std::invalid_argument("unknown trajectory format");
 }
 
-namespace {
-// q and -q are the same rotation; writing the one with w >= 0 makes files deterministic and diffable.
 Eigen::Quaterniond canonicalQuaternion(const Eigen::Matrix3d& R) {
   Eigen::Quaterniond q = Eigen::Quaterniond(R).normalized();
   if (q.w() < 0) q.coeffs() = -q.coeffs();
   return q;
 }
+
+namespace {
 
 constexpr const char* kTumHeader = "# t[s] x y z qx qy qz qw (T_world_body)\n";
 

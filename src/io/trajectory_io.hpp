@@ -53,6 +53,10 @@ class TumStream {
   Time last_ = 0;
 };
 
+// The unit quaternion of R with w >= 0: q and -q are the same rotation, and writing one of them makes files
+// deterministic and diffable.
+Eigen::Quaterniond canonicalQuaternion(const Eigen::Matrix3d& R);
+
 // Writes `content` to `path` atomically (temporary file + rename). Throws IoError on failure.
 void writeFileAtomically(const std::string& path, const std::string& content);
 

@@ -112,6 +112,22 @@ TEST(SimCli, ExistingOutputFolderNeedsForce) {
   EXPECT_TRUE(fs::exists(dir / "taken" / "calibration.yaml"));
 }
 
+TEST(SimCli, TheEurocFormatRefusesALidarAndReplacesOnlyItsOwnOutput) {
+  TempDir dir;
+  const CliResult lidar =
+      runDrover("sim --scenario mav-room --format euroc --lidar vlp16 --duration 1 --out " + (dir / "x").string());
+  EXPECT_EQ(lidar.exit_code, 2) << lidar.output;
+  EXPECT_TRUE(contains(lidar.output, "--lidar") && contains(lidar.output, "no lidar")) << lidar.output;
+  EXPECT_EQ(std::count(lidar.output.begin(), lidar.output.end(), '\n'), 1) << lidar.output;
+  EXPECT_FALSE(fs::exists(dir / "x"));
+  writeText(dir / "mine" / "notes.txt", "keep\n");
+  const CliResult foreign =
+      runDrover("sim --scenario mav-room --format euroc --duration 1 --force --out " + (dir / "mine").string());
+  EXPECT_EQ(foreign.exit_code, 2) << foreign.output;
+  EXPECT_TRUE(contains(foreign.output, "not a simulated EuRoC dataset")) << foreign.output;
+  EXPECT_TRUE(fs::exists(dir / "mine" / "notes.txt"));
+}
+
 TEST(SimCli, BadArgumentsExitWithCode2) {
   TempDir dir;
   const std::string out = " --out " + (dir / "x").string();
