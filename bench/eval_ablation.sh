@@ -12,8 +12,8 @@
 #   the farm course takes ~6.5 min a row instead of ~9.5). The row drover+superpoint is the whole preset regardless,
 #   drover+superpoint-PART the whole preset without PART (drover+superpoint-lk-min-eigenvalue: SuperPoint's tracks at
 #   the platform's LK threshold).
-# Courses are generated once into $DROVER_OUT/sim/<course>-cam (farm-N: seed N; kitti05-replay needs ../shared/data
-# and ~14 GB with its camera). Runs are kept in $DROVER_OUT/ablation/<course>/<row>.
+# Courses are generated once into $DROVER_OUT/sim/<course>-cam (<scenario>-N, e.g. farm-2: seed N; kitti05-replay
+# needs ../shared/data and ~14 GB with its camera). Runs are kept in $DROVER_OUT/ablation/<course>/<row>.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 . scripts/sim_cache.sh
@@ -42,7 +42,7 @@ row_flags() {  # the drover run options of a row
 mkdir -p bench/out/ablation "$OUT_ROOT/sim"
 for c in "${COURSES[@]}"; do
   scenario=$c seed=1
-  case "$c" in farm-*) scenario=farm seed=${c#farm-} ;; esac
+  case "${c##*-}" in ''|*[!0-9]*) ;; *) scenario=${c%-*} seed=${c##*-} ;; esac  # farm-2, white-walls-3: seed N
   data="$OUT_ROOT/sim/$c-cam"
   CONFIG=${ABLATION_CONFIG:-$(platform_config "$c")}
   course_is_current "$data" "$CONFIG" ||

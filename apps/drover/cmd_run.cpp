@@ -22,6 +22,7 @@
 #include "apps/drover/run_vis.hpp"
 #include "io/config.hpp"
 #include "io/dataset.hpp"
+#include "io/odometry/imu_noise_check.hpp"
 #include "io/odometry/live_config_io.hpp"
 #include "io/odometry/odometry_config_io.hpp"
 #include "io/read_ahead.hpp"
@@ -171,6 +172,15 @@ bool cameraUsable(const Calibration& calibration, bool no_lidar, const RunOption
 }
 
 // --realtime: the dataset at sensor rate through pipeline::System (threads, bounded queues), then the same files.
+// A EuRoC sequence says what its IMU's noise is; the estimators use the config's. A config written for another IMU
+// gets a warning per figure that is off by more than io::kImuNoiseReportFactor.
+void warnOfImuNoise(const RunOptions& o, const imu::PreintegrationConfig& used) {
+  if (o.format != "euroc") return;
+  const std::string config_name = o.config.empty() ? "built-in default" : o.config;
+  for (const std::string& line : io::imuNoiseDisagreements(io::readEurocImuNoise(o.dataset), used, config_name))
+    spdlog::warn("{}", line);
+}
+
 void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& config, io::Reader& reader) {
   pipeline::SystemConfig system_config;
   system_config.odometry = config;
@@ -223,6 +233,7 @@ void runOdometry(const RunOptions& o) {
   if (o.no_loop) config.loop.enabled = false;
   const io::DatasetOptions dataset_options = datasetOptions(o);
   std::unique_ptr<io::Reader> reader = io::openDataset(o.dataset, o.format, dataset_options);
+  warnOfImuNoise(o, config.preintegration);
   if (o.realtime) return runRealtimeOdometry(o, config, *reader);
   // Decoding images and parsing lidar files in a thread of their own, ahead of the odometry: the same stream.
   reader = io::readAhead(std::move(reader));

@@ -281,6 +281,25 @@ Calibration readEurocCalibration(const std::string& mav0_dir) {
   return calib;
 }
 
+EurocImuNoise readEurocImuNoise(const std::string& dir) {
+  EurocImuNoise noise;
+  noise.file = (findLayout(dir).mav0 / "imu0" / "sensor.yaml").string();
+  const YAML::Node root = loadSensorYaml(noise.file);
+  const auto figure = [&](const char* key) -> std::optional<double> {
+    const YAML::Node node = root[key];
+    if (!node) return std::nullopt;
+    const double value = parseDouble(scalarText(node, key, noise.file), noise.file, keyRecord(node, key));
+    if (!std::isfinite(value) || value < 0)
+      fail(noise.file, keyRecord(node, key), "expected a noise density >= 0, got " + formatDouble(value));
+    return value;
+  };
+  noise.gyroscope_noise_density = figure("gyroscope_noise_density");
+  noise.gyroscope_random_walk = figure("gyroscope_random_walk");
+  noise.accelerometer_noise_density = figure("accelerometer_noise_density");
+  noise.accelerometer_random_walk = figure("accelerometer_random_walk");
+  return noise;
+}
+
 std::unique_ptr<Reader> openEuroc(const std::string& dir, const DatasetOptions& options) {
   const Layout layout = findLayout(dir);
   Calibration calib = readEurocCalibration(layout.mav0.string());

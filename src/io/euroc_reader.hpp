@@ -9,6 +9,7 @@
 // nonetheless compose with T_B_imu so the ground truth is exactly T_world_imu.
 #include <Eigen/Geometry>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "io/dataset.hpp"
@@ -30,5 +31,19 @@ Eigen::Isometry3d readEurocSensorExtrinsics(const std::string& sensor_yaml);
 // Calibration from mav0/imu0/sensor.yaml and mav0/cam0/sensor.yaml: T_imu_cam = inv(T_B_imu) * T_B_cam,
 // camera intrinsics and distortion. EuRoC has no lidar (T_imu_lidar stays identity) and no time offsets.
 Calibration readEurocCalibration(const std::string& mav0_dir);
+
+// The IMU noise figures of mav0/imu0/sensor.yaml (Kalibr's continuous-time densities). The reader does not use
+// them: the estimators take theirs from the platform config (odometry.imu), which may inflate them on purpose.
+// They are read so that a config that disagrees with the sensor can be reported. A figure the file does not give is
+// empty; one that is given but is not a finite number >= 0 throws IoError naming the file and key.
+struct EurocImuNoise {
+  std::string file;                               // the sensor.yaml read
+  std::optional<double> gyroscope_noise_density;  // [rad/s/sqrt(Hz)]
+  std::optional<double> gyroscope_random_walk;    // [rad/s^2/sqrt(Hz)]
+  std::optional<double> accelerometer_noise_density;  // [m/s^2/sqrt(Hz)]
+  std::optional<double> accelerometer_random_walk;    // [m/s^3/sqrt(Hz)]
+};
+// `dir` as for openEuroc.
+EurocImuNoise readEurocImuNoise(const std::string& dir);
 
 }  // namespace drover::io

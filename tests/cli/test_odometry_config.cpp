@@ -86,7 +86,8 @@ TEST(OdometryConfigReader, CarSimIsTheFarmsPlatformWithTheOutdoorPlaneLeafTheCar
                    pipeline::LoopClosureConfig{}.odometry_sigma_rotation);
 }
 
-TEST(OdometryConfigReader, ConfigsWithoutAnOdometrySectionGiveExactlyTheDefaults) {
+// euroc.yaml and lvisam.yaml describe their sensors (the IMU's noise, the lidar's rings) and nothing of the method.
+TEST(OdometryConfigReader, ConfigsThatDescribeOnlyTheirSensorsLeaveTheMethodAtTheDefaults) {
   const OdometryConfig d;
   for (const char* name : {"euroc.yaml", "lvisam.yaml"}) {
     SCOPED_TRACE(name);

@@ -252,6 +252,34 @@ TEST_F(EurocFixture, RejectsAZeroOrNonFiniteFocalLengthNamingTheKey) {
   EXPECT_TRUE(contains(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
 }
 
+TEST_F(EurocFixture, ImuNoiseFiguresTheSensorYamlLeavesOutAreEmpty) {
+  write("mav0/imu0/sensor.yaml", std::string(kImuYaml) + "gyroscope_noise_density: 1.5e-4\n");
+  const EurocImuNoise noise = readEurocImuNoise(seq());
+  EXPECT_TRUE(contains(noise.file, "mav0/imu0/sensor.yaml")) << noise.file;
+  EXPECT_EQ(noise.gyroscope_noise_density, 1.5e-4);
+  EXPECT_FALSE(noise.gyroscope_random_walk.has_value());
+  EXPECT_FALSE(noise.accelerometer_noise_density.has_value());
+  EXPECT_FALSE(noise.accelerometer_random_walk.has_value());
+}
+
+TEST_F(EurocFixture, RejectsANegativeOrNonNumericImuNoiseFigureNamingTheKey) {
+  write("mav0/imu0/sensor.yaml", std::string(kImuYaml) + "accelerometer_random_walk: -3.0e-3\n");
+  try {
+    readEurocImuNoise(seq());
+    FAIL() << "expected an IoError";
+  } catch (const IoError& e) {
+    EXPECT_TRUE(contains(e.what(), "imu0/sensor.yaml (line 11, key 'accelerometer_random_walk')")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "expected a noise density >= 0, got -0.003")) << e.what();
+  }
+  write("mav0/imu0/sensor.yaml", std::string(kImuYaml) + "gyroscope_random_walk: [1, 2]\n");
+  try {
+    readEurocImuNoise(seq());
+    FAIL() << "expected an IoError";
+  } catch (const IoError& e) {
+    EXPECT_TRUE(contains(e.what(), "key 'gyroscope_random_walk'")) << e.what();
+  }
+}
+
 TEST_F(EurocFixture, RejectsNanInAnImuLine) {
   write("mav0/imu0/data.csv", "1000,0.1,nan,0.3,1.0,2.0,9.81\n");
   const std::string msg = errorOf();

@@ -158,6 +158,16 @@ TEST(EurocReader, AcceptsTheMav0FolderItself) {
   EXPECT_EQ(readAll(*reader).imu.size(), 29120u);
 }
 
+// The ADIS16448's figures as the snippet's imu0/sensor.yaml gives them (read by hand).
+TEST(EurocReader, TheImuNoiseFiguresAreThoseOfTheSnippetsSensorYaml) {
+  DROVER_REQUIRE_SHARED(kSeq);
+  const EurocImuNoise noise = readEurocImuNoise(kSeq.string());
+  EXPECT_EQ(noise.gyroscope_noise_density, 1.6968e-04);
+  EXPECT_EQ(noise.gyroscope_random_walk, 1.9393e-05);
+  EXPECT_EQ(noise.accelerometer_noise_density, 2.0e-3);
+  EXPECT_EQ(noise.accelerometer_random_walk, 3.0e-3);
+}
+
 TEST(EurocReader, HonoursLoadImuAndLoadImages) {
   DROVER_REQUIRE_SHARED(kSeq);
   DatasetOptions none;

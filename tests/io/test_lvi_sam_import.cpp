@@ -87,6 +87,25 @@ TEST(LviSamImport, LviSamsShippedExtrinsicsGiveExactlyTheTransformsConfigLvisamD
   EXPECT_EQ(got.calibration.camera_time_offset, 0);
 }
 
+// The shipped platform file for LVI-SAM's bags holds the sensor settings the importer takes from LVI-SAM's files:
+// without them its bags ran on the farm robot's IMU noise (imuGyrNoise 1.6e-3 against 1.7e-4) and took the
+// MicroStrain's orientation output as the IMU frame's.
+TEST(LviSamImport, ConfigLvisamHoldsTheImuNoiseTheOrientationFlagAndTheLayoutLviSamsFilesGive) {
+  const LviSamImport r = importLviSamFiles({kLidar, kCamera});
+  const YAML::Node doc = YAML::LoadFile(std::string(DROVER_SOURCE_DIR) + "/config/lvisam.yaml");
+  for (const char* key : {"acc_noise_density", "gyro_noise_density", "acc_bias_random_walk", "gyro_bias_random_walk",
+                          "gravity"}) {
+    SCOPED_TRACE(key);
+    ASSERT_TRUE(doc["odometry"]["imu"][key]);
+    EXPECT_EQ(doc["odometry"]["imu"][key].as<double>(), at(r, std::string("odometry.imu.") + key).as<double>());
+  }
+  ASSERT_TRUE(doc["odometry"]["use_imu_orientation"]);
+  EXPECT_EQ(doc["odometry"]["use_imu_orientation"].as<bool>(), at(r, "odometry.use_imu_orientation").as<bool>());
+  EXPECT_EQ(doc["odometry"]["layout"]["n_rings"].as<int>(), at(r, "odometry.layout.n_rings").as<int>());
+  EXPECT_EQ(doc["odometry"]["layout"]["columns"].as<int>(), at(r, "odometry.layout.columns").as<int>());
+  EXPECT_EQ(doc["odometry"]["features"]["columns"].as<int>(), at(r, "odometry.features.columns").as<int>());
+}
+
 TEST(LviSamImport, ExtrinsicRotAndTransAreRLidarImuAndTheImuOriginInTheLidarFrame) {
   // R_lidar_imu = Rz(+90 deg), IMU origin at (1, 2, 3) in the lidar frame.
   const LviSamImport r = importText(
