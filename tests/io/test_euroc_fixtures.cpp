@@ -6,6 +6,7 @@
 
 #include "io/error.hpp"
 #include "io/euroc_reader.hpp"
+#include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
@@ -264,20 +265,11 @@ TEST_F(EurocFixture, ImuNoiseFiguresTheSensorYamlLeavesOutAreEmpty) {
 
 TEST_F(EurocFixture, RejectsANegativeOrNonNumericImuNoiseFigureNamingTheKey) {
   write("mav0/imu0/sensor.yaml", std::string(kImuYaml) + "accelerometer_random_walk: -3.0e-3\n");
-  try {
-    readEurocImuNoise(seq());
-    FAIL() << "expected an IoError";
-  } catch (const IoError& e) {
-    EXPECT_TRUE(contains(e.what(), "imu0/sensor.yaml (line 11, key 'accelerometer_random_walk')")) << e.what();
-    EXPECT_TRUE(contains(e.what(), "expected a noise density >= 0, got -0.003")) << e.what();
-  }
+  test::expectIoError([&] { readEurocImuNoise(seq()); },
+                      {"imu0/sensor.yaml (line 11, key 'accelerometer_random_walk')",
+                       "expected a noise density >= 0, got -0.003"});
   write("mav0/imu0/sensor.yaml", std::string(kImuYaml) + "gyroscope_random_walk: [1, 2]\n");
-  try {
-    readEurocImuNoise(seq());
-    FAIL() << "expected an IoError";
-  } catch (const IoError& e) {
-    EXPECT_TRUE(contains(e.what(), "key 'gyroscope_random_walk'")) << e.what();
-  }
+  test::expectIoError([&] { readEurocImuNoise(seq()); }, {"key 'gyroscope_random_walk'", "expected a single value"});
 }
 
 TEST_F(EurocFixture, RejectsNanInAnImuLine) {
