@@ -171,7 +171,6 @@ bool cameraUsable(const Calibration& calibration, bool no_lidar, const RunOption
   return false;
 }
 
-// --realtime: the dataset at sensor rate through pipeline::System (threads, bounded queues), then the same files.
 // A EuRoC sequence says what its IMU's noise is; the estimators use the config's. A config written for another IMU
 // gets a warning per figure that is off by more than io::kImuNoiseReportFactor.
 void warnOfImuNoise(const RunOptions& o, const imu::PreintegrationConfig& used) {
@@ -181,6 +180,7 @@ void warnOfImuNoise(const RunOptions& o, const imu::PreintegrationConfig& used) 
     spdlog::warn("{}", line);
 }
 
+// --realtime: the dataset at sensor rate through pipeline::System (threads, bounded queues), then the same files.
 void runRealtimeOdometry(const RunOptions& o, const pipeline::OdometryConfig& config, io::Reader& reader) {
   pipeline::SystemConfig system_config;
   system_config.odometry = config;

@@ -2,7 +2,7 @@
 // The platform config's IMU noise (odometry.imu) held against what the dataset says of its IMU. The estimators use
 // the config's figures only; a dataset's own are read to catch a config written for another IMU. EuRoC's ADIS16448
 // walks its accelerometer bias at 3e-3 m/s^3/sqrt(Hz); config/euroc.yaml without an imu section weighed it by the
-// farm robot's 3e-4 and doubled the VIS's error on the simulated EuRoC flight (0.023 -> 0.058 m).
+// farm robot's 3e-4, and the VIS's error on the simulated EuRoC flight grew from 0.023 to 0.058 m.
 #include <string>
 #include <vector>
 
