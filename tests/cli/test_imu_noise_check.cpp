@@ -13,7 +13,7 @@
 namespace drover::io {
 namespace {
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+using test::contains;
 
 EurocImuNoise adis16448() {  // EuRoC's imu0/sensor.yaml
   EurocImuNoise n;
