@@ -18,7 +18,7 @@ using namespace drover::backend::test;
 
 namespace {
 
-constexpr double kJacobianTolerance = 1e-6;  // relative, as test_factors.cpp
+constexpr double kGroundJacobianTolerance = 1e-6;  // relative, as test_factors.cpp
 
 // A forward-looking camera 0.1 m above and 0.2 m ahead of the IMU, z_cam = x_body, x_cam = -y_body, y_cam = -z_body.
 Eigen::Isometry3d forwardCamera() {
@@ -54,7 +54,7 @@ TEST(GroundHeightFactor, AnalyticJacobiansMatchNumericalOnesForEveryBlock) {
         forwardCamera() * geometry::makeIsometry(geometry::expQuat(0.2 * Eigen::Vector3d(u(rng), u(rng), u(rng))),
                                                  0.1 * Eigen::Vector3d(u(rng), u(rng), u(rng)));
     const GroundHeightFactor factor(Eigen::Vector2d(0.4 * u(rng), 0.2 + 0.2 * u(rng)), 0.4 + 0.2 * u(rng), 0.03);
-    EXPECT_LT(tangentJacobianError(factor, paramsOf(T_ic, 0.3 + 0.2 * u(rng))), kJacobianTolerance) << trial;
+    EXPECT_LT(tangentJacobianError(factor, paramsOf(T_ic, 0.3 + 0.2 * u(rng))), kGroundJacobianTolerance) << trial;
   }
 }
 

@@ -13,11 +13,12 @@
 #include "backend/quaternion_manifold.hpp"
 #include "geometry/so3.hpp"
 #include "pose_graph_test_util.hpp"
+#include "support/units.hpp"
 
 namespace drover::backend {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kPi;
 
 Eigen::Quaterniond someRotation(std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1, 1);

@@ -18,7 +18,7 @@ using namespace drover::backend::test;
 
 namespace {
 
-constexpr double kJacobianTolerance = 1e-6;  // relative, as test_factors.cpp
+constexpr double kVisualJacobianTolerance = 1e-6;  // relative, as test_factors.cpp
 constexpr double kFocal = 460.0;             // [px]
 constexpr double kSigmaPx = 1.5;             // [px]
 constexpr double kSqrtInfo = kFocal / kSigmaPx;
@@ -141,8 +141,8 @@ TEST(ReprojectionFactor, AnalyticJacobiansMatchCentralDifferencesWithTimeOffsetA
     const ReprojectionFactor factor = randomFactor(rng, &b);
     const auto params = paramsOf(b);
     EXPECT_GT(evaluate(factor, params).norm(), 0.5) << "seed " << seed;  // away from the minimum
-    EXPECT_LT(tangentJacobianError(factor, params), kJacobianTolerance) << "seed " << seed;
-    EXPECT_LT(ambientJacobianError(factor, params), kJacobianTolerance) << "seed " << seed;
+    EXPECT_LT(tangentJacobianError(factor, params), kVisualJacobianTolerance) << "seed " << seed;
+    EXPECT_LT(ambientJacobianError(factor, params), kVisualJacobianTolerance) << "seed " << seed;
   }
 }
 
@@ -189,7 +189,7 @@ TEST(ReprojectionFactor, TimeOffsetMovesObservationsAlongTheirVelocityZeroResidu
   EXPECT_LT(evaluate(factor, paramsOf(b)).norm(), 1e-9);
   b.td = 0.0;  // 20 ms at ~0.2 1/s image velocity: about 2 px, more than one sigma
   EXPECT_GT(evaluate(factor, paramsOf(b)).norm(), 1.0);
-  EXPECT_LT(tangentJacobianError(factor, paramsOf(b)), kJacobianTolerance);
+  EXPECT_LT(tangentJacobianError(factor, paramsOf(b)), kVisualJacobianTolerance);
 }
 
 TEST(ReprojectionFactor, APointBehindACameraEvaluatesToALargeResidualAndOnlyASingularOneFails) {
@@ -254,7 +254,7 @@ TEST(InverseDepthFactor, WhitensTheInverseDepthErrorByTheFirstOrderSigmaOfOneOve
   // A depth one sigma farther: -1 to first order in sigma / d = 2 % (exactly -d / (d + sigma)).
   EXPECT_NEAR(residualAt(1.0 / (d + sigma)), -d / (d + sigma), 1e-9);
   EXPECT_NEAR(residualAt(1.0 / (d + sigma)), -1.0, 0.03);
-  EXPECT_LT(tangentJacobianError(factor, {vectorParam(Eigen::Matrix<double, 1, 1>(0.3))}), kJacobianTolerance);
+  EXPECT_LT(tangentJacobianError(factor, {vectorParam(Eigen::Matrix<double, 1, 1>(0.3))}), kVisualJacobianTolerance);
 }
 
 TEST(InverseDepthFactor, RejectsNonPositiveOrNonFiniteDepthAndSigma) {

@@ -50,13 +50,6 @@ void appendNanPoints(const fs::path& bin, int n) {
   }
 }
 
-void writeText(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
-
-std::string readText(const fs::path& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 TEST(BadDataCli, InfoDropsNanPointsOfAKittiScanWithAWarningAndCountsThem) {
   DROVER_REQUIRE_SHARED(kKitti00);
   TempDir dir;

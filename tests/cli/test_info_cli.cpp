@@ -15,8 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-const fs::path kEuroc = sharedData("euroc/V1_01_easy_micro");
-const fs::path kKitti00 = sharedData("kitti/sequences/00");
+const fs::path kInfoEuroc = sharedData("euroc/V1_01_easy_micro");
+const fs::path kInfoKitti00 = sharedData("kitti/sequences/00");
 
 Json readJson(const fs::path& p) {
   std::ifstream in(p);
@@ -35,9 +35,9 @@ std::vector<std::string> dataLines(const fs::path& p) {
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 TEST(InfoCli, SummarisesTheEurocSnippet) {
-  DROVER_REQUIRE_SHARED(kEuroc);
+  DROVER_REQUIRE_SHARED(kInfoEuroc);
   TempDir dir;
-  const CliResult r = runDrover("info " + kEuroc.string() + " --format euroc --json " + (dir / "info.json").string());
+  const CliResult r = runDrover("info " + kInfoEuroc.string() + " --format euroc --json " + (dir / "info.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(contains(r.output, "29120 samples")) << r.output;
   EXPECT_TRUE(contains(r.output, "752x480 px")) << r.output;
@@ -64,10 +64,10 @@ TEST(InfoCli, SummarisesTheEurocSnippet) {
 }
 
 TEST(InfoCli, ExportsTheGroundTruthAsTum) {
-  DROVER_REQUIRE_SHARED(kEuroc);
+  DROVER_REQUIRE_SHARED(kInfoEuroc);
   TempDir dir;
   const fs::path tum = dir / "gt.tum";
-  const CliResult r = runDrover("info " + kEuroc.string() + " --format euroc --export-gt " + tum.string());
+  const CliResult r = runDrover("info " + kInfoEuroc.string() + " --format euroc --export-gt " + tum.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::vector<std::string> lines = dataLines(tum);
   ASSERT_EQ(lines.size(), 28712u);
@@ -85,10 +85,10 @@ TEST(InfoCli, ExportsTheGroundTruthAsTum) {
 }
 
 TEST(InfoCli, HonoursTheConfigFile) {
-  DROVER_REQUIRE_SHARED(kEuroc);
+  DROVER_REQUIRE_SHARED(kInfoEuroc);
   TempDir dir;
   writeText(dir / "no_images.yaml", "dataset:\n  load_images: false\n");
-  const CliResult r = runDrover("info " + kEuroc.string() + " --format euroc --config " +
+  const CliResult r = runDrover("info " + kInfoEuroc.string() + " --format euroc --config " +
                                 (dir / "no_images.yaml").string() + " --json " + (dir / "info.json").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Json j = readJson(dir / "info.json");
@@ -97,7 +97,7 @@ TEST(InfoCli, HonoursTheConfigFile) {
 }
 
 TEST(InfoCli, SummarisesTenKittiFrames) {
-  DROVER_REQUIRE_SHARED(kKitti00);
+  DROVER_REQUIRE_SHARED(kInfoKitti00);
   // The snippet lists all 4541 frames in times.txt but holds only the first 10 scans, so build a 10-frame
   // sequence that links to them (times.txt and poses.txt cut to 10 lines).
   TempDir dir;
@@ -108,12 +108,12 @@ TEST(InfoCli, SummarisesTenKittiFrames) {
     char buf[16];
     std::snprintf(buf, sizeof(buf), "%06d", i);
     const std::string name(buf);
-    fs::create_symlink(kKitti00 / "velodyne" / (name + ".bin"), seq / "velodyne" / (name + ".bin"));
-    fs::create_symlink(kKitti00 / "image_2" / (name + ".png"), seq / "image_2" / (name + ".png"));
+    fs::create_symlink(kInfoKitti00 / "velodyne" / (name + ".bin"), seq / "velodyne" / (name + ".bin"));
+    fs::create_symlink(kInfoKitti00 / "image_2" / (name + ".png"), seq / "image_2" / (name + ".png"));
   }
-  fs::copy_file(kKitti00 / "calib.txt", seq / "calib.txt");
+  fs::copy_file(kInfoKitti00 / "calib.txt", seq / "calib.txt");
   for (const char* file : {"times.txt", "poses.txt"}) {
-    std::ifstream in(kKitti00 / file);
+    std::ifstream in(kInfoKitti00 / file);
     std::ofstream out(seq / file);
     std::string line;
     for (int i = 0; i < 10 && std::getline(in, line); ++i) out << line << "\n";
@@ -141,9 +141,9 @@ TEST(InfoCli, SummarisesTenKittiFrames) {
 }
 
 TEST(InfoCli, MaxFramesReadsTheSnippetInPlaceAndWithoutItTheMissingScanIsNamed) {
-  DROVER_REQUIRE_SHARED(kKitti00);
+  DROVER_REQUIRE_SHARED(kInfoKitti00);
   TempDir dir;
-  const CliResult ok = runDrover("info " + kKitti00.string() + " --format kitti --max-frames 10 --json " +
+  const CliResult ok = runDrover("info " + kInfoKitti00.string() + " --format kitti --max-frames 10 --json " +
                                  (dir / "info.json").string());
   ASSERT_EQ(ok.exit_code, 0) << ok.output;
   const Json j = readJson(dir / "info.json");
@@ -151,7 +151,7 @@ TEST(InfoCli, MaxFramesReadsTheSnippetInPlaceAndWithoutItTheMissingScanIsNamed) 
   EXPECT_EQ(j["camera"]["count"], 10);
   EXPECT_EQ(j["lidar"]["last_time_ns"].get<std::int64_t>(), 933146700);
   // times.txt lists 4541 frames but the snippet stops at 000009.bin: reading all of it is an error at frame 10.
-  const CliResult bad = runDrover("info " + kKitti00.string() + " --format kitti");
+  const CliResult bad = runDrover("info " + kInfoKitti00.string() + " --format kitti");
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.output.find("000010.bin (frame 10)"), std::string::npos) << bad.output;
 }
@@ -172,22 +172,22 @@ TEST(InfoCli, UnknownFormatExitsWith2) {
 }
 
 TEST(InfoCli, ConfigWithATypoExitsWith2NamingTheKey) {
-  DROVER_REQUIRE_SHARED(kEuroc);
+  DROVER_REQUIRE_SHARED(kInfoEuroc);
   TempDir dir;
   writeText(dir / "typo.yaml", "dataset:\n  load_imgs: false\n");
   const CliResult r =
-      runDrover("info " + kEuroc.string() + " --format euroc --config " + (dir / "typo.yaml").string());
+      runDrover("info " + kInfoEuroc.string() + " --format euroc --config " + (dir / "typo.yaml").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(contains(r.output, "dataset.load_imgs")) << r.output;
 }
 
 TEST(InfoCli, ExportingMissingGroundTruthExitsWith2) {
-  DROVER_REQUIRE_SHARED(kEuroc);
+  DROVER_REQUIRE_SHARED(kInfoEuroc);
   // A copy of the sequence's mav0 without any ground truth, by linking only imu0 and cam0.
   TempDir dir;
   fs::create_directories(dir / "seq" / "mav0");
-  fs::create_directory_symlink(kEuroc / "mav0" / "imu0", dir / "seq" / "mav0" / "imu0");
-  fs::create_directory_symlink(kEuroc / "mav0" / "cam0", dir / "seq" / "mav0" / "cam0");
+  fs::create_directory_symlink(kInfoEuroc / "mav0" / "imu0", dir / "seq" / "mav0" / "imu0");
+  fs::create_directory_symlink(kInfoEuroc / "mav0" / "cam0", dir / "seq" / "mav0" / "cam0");
   const CliResult r = runDrover("info " + (dir / "seq").string() + " --format euroc --export-gt " +
                                 (dir / "gt.tum").string());
   EXPECT_EQ(r.exit_code, 2);

@@ -12,35 +12,29 @@
 namespace drover::test {
 namespace {
 
-std::string write(const TempDir& dir, const std::string& yaml) {
-  const auto p = dir / "platform.yaml";
-  writeText(p, yaml);
-  return p.string();
-}
-
 TEST(LiveConfigIo, KeysReachTheConfigAndAMissingSectionKeepsTheDefaults) {
   TempDir dir;
   const pipeline::LiveConfig c =
-      io::loadLiveConfig(write(dir, "live:\n  sweep_queue: 4\n  frame_queue: 3\n  loop_rate_hz: 2.5\n"
+      io::loadLiveConfig(writePlatformFile(dir, "live:\n  sweep_queue: 4\n  frame_queue: 3\n  loop_rate_hz: 2.5\n"
                                     "  clock_jump_s: 0.5\n  sensor_gap_s: 2\n"));
   EXPECT_EQ(c.sweep_queue, 4);
   EXPECT_DOUBLE_EQ(c.clock_jump_s, 0.5);
   EXPECT_DOUBLE_EQ(c.sensor_gap_s, 2.0);
   EXPECT_EQ(c.frame_queue, 3);
   EXPECT_DOUBLE_EQ(c.loop_rate_hz, 2.5);
-  const pipeline::LiveConfig d = io::loadLiveConfig(write(dir, "odometry:\n  use_imu: true\n"));
+  const pipeline::LiveConfig d = io::loadLiveConfig(writePlatformFile(dir, "odometry:\n  use_imu: true\n"));
   EXPECT_EQ(d.sweep_queue, pipeline::LiveConfig{}.sweep_queue);
 }
 
 TEST(LiveConfigIo, AnUnknownKeyOrABadValueNamesTheFileTheLineAndTheKey) {
   TempDir dir;
-  const std::string bad_queue = write(dir, "live:\n  sweep_queue: 0\n");
+  const std::string bad_queue = writePlatformFile(dir, "live:\n  sweep_queue: 0\n");
   expectIoError([&] { io::loadLiveConfig(bad_queue); }, {bad_queue, "live.sweep_queue"});
-  const std::string unknown = write(dir, "live:\n  sweep_queues: 2\n");
+  const std::string unknown = writePlatformFile(dir, "live:\n  sweep_queues: 2\n");
   expectIoError([&] { io::loadLiveConfig(unknown); }, {unknown, "line 2", "sweep_queues"});
-  const std::string junk = write(dir, "live:\n  loop_rate_hz: fast\n");
+  const std::string junk = writePlatformFile(dir, "live:\n  loop_rate_hz: fast\n");
   expectIoError([&] { io::loadLiveConfig(junk); }, {junk, "loop_rate_hz"});
-  const std::string no_jump = write(dir, "live:\n  clock_jump_s: 0\n");
+  const std::string no_jump = writePlatformFile(dir, "live:\n  clock_jump_s: 0\n");
   expectIoError([&] { io::loadLiveConfig(no_jump); }, {no_jump, "live.clock_jump_s"});
 }
 

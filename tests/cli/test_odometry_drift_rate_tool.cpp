@@ -13,7 +13,7 @@
 namespace drover {
 namespace {
 
-std::string tumLine(double t_s, double x, double yaw) {
+std::string tumYawLine(double t_s, double x, double yaw) {
   char line[200];
   std::snprintf(line, sizeof line, "%.9f %.9f 0 0 0 0 %.12f %.12f\n", t_s, x, std::sin(yaw / 2), std::cos(yaw / 2));
   return line;
@@ -21,7 +21,7 @@ std::string tumLine(double t_s, double x, double yaw) {
 
 nlohmann::json runTool(const test::TempDir& dir, const std::string& estimate) {
   std::string truth;
-  for (int k = 0; k < 40; ++k) truth += tumLine(k, k, 0);  // 1 m a keyframe along x, one keyframe a second
+  for (int k = 0; k < 40; ++k) truth += tumYawLine(k, k, 0);  // 1 m a keyframe along x, one keyframe a second
   test::writeText(dir / "course" / "groundtruth.txt", truth);
   test::writeText(dir / "run" / "keyframes.tum", estimate);
   const test::CliResult r = test::runShell("/usr/bin/python3 " + std::string(DROVER_SOURCE_DIR) +
@@ -35,7 +35,7 @@ nlohmann::json runTool(const test::TempDir& dir, const std::string& estimate) {
 TEST(OdometryDriftRateTool, GivesTheRandomWalkSigmaPerStepOfAScaleError) {
   test::TempDir dir;
   std::string estimate;
-  for (int k = 0; k < 40; ++k) estimate += tumLine(k, 1.01 * k, 0);
+  for (int k = 0; k < 40; ++k) estimate += tumYawLine(k, 1.01 * k, 0);
   const nlohmann::json j = runTool(dir, estimate);
   ASSERT_EQ(j.at("spans").size(), 3u);
   for (const auto& span : j.at("spans")) {
@@ -50,7 +50,7 @@ TEST(OdometryDriftRateTool, GivesTheRandomWalkSigmaPerStepOfAScaleError) {
 TEST(OdometryDriftRateTool, GivesTheRandomWalkSigmaPerStepOfAHeadingRateError) {
   test::TempDir dir;
   std::string estimate;
-  for (int k = 0; k < 40; ++k) estimate += tumLine(k, k, 1e-3 * k);
+  for (int k = 0; k < 40; ++k) estimate += tumYawLine(k, k, 1e-3 * k);
   const nlohmann::json j = runTool(dir, estimate);
   ASSERT_EQ(j.at("spans").size(), 3u);
   for (const auto& span : j.at("spans")) {
@@ -71,7 +71,7 @@ TEST(OdometryDriftRateTool, NamesTheMissingFileAndFails) {
 
 TEST(OdometryDriftRateTool, NamesAFileThatIsNotATrajectoryAndFails) {
   test::TempDir dir;
-  test::writeText(dir / "course" / "groundtruth.txt", tumLine(0, 0, 0) + tumLine(1, 1, 0));
+  test::writeText(dir / "course" / "groundtruth.txt", tumYawLine(0, 0, 0) + tumYawLine(1, 1, 0));
   test::writeText(dir / "run" / "keyframes.tum", "0 1 2\n");
   const test::CliResult r = test::runShell("/usr/bin/python3 " + std::string(DROVER_SOURCE_DIR) +
                                           "/tools/odometry_drift_rate.py " + (dir / "course").string() + " " +

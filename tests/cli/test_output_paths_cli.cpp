@@ -16,7 +16,7 @@ namespace drover::test {
 namespace {
 namespace fs = std::filesystem;
 
-const std::string kSimConfig = std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml";
+const std::string kFarmSimConfig = std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml";
 
 // Inputs shared by the tests: a 1 s simulated dataset, two TUM trajectories, a g2o graph, an image; and the three
 // kinds of unusable output path.
@@ -65,7 +65,7 @@ const std::string kIsFile = "is a file, not a folder";
 const std::string kNoFolder = "does not exist";
 
 TEST_F(OutputPaths, RunChecksOut) {
-  expectRefused("run " + data() + " --format sim --config " + kSimConfig + " --out " + file(), file(), "--out",
+  expectRefused("run " + data() + " --format sim --config " + kFarmSimConfig + " --out " + file(), file(), "--out",
                 kIsFile);
   EXPECT_EQ(readText(file()), "mine");
 }
@@ -112,7 +112,7 @@ TEST_F(OutputPaths, EvalChecksJsonAndPlot) {
 
 TEST_F(OutputPaths, LoopPairAndLoopEvalCheckJson) {
   expectRefused("loop pair " + in("a.bin") + " " + in("b.bin") + " --json " + folder(), folder(), "--json", kIsFolder);
-  expectRefused("loop eval " + data() + " --format sim --config " + kSimConfig + " --json " + missing(), missing(),
+  expectRefused("loop eval " + data() + " --format sim --config " + kFarmSimConfig + " --json " + missing(), missing(),
                 "--json", kNoFolder);
 }
 

@@ -21,9 +21,7 @@ namespace fs = std::filesystem;
 using fuzz::hallScan;
 using fuzz::writeKittiSequence;
 
-std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
-
-std::vector<std::string> linesWith(const std::string& output, const std::string& tag) {
+std::vector<std::string> taggedLines(const std::string& output, const std::string& tag) {
   std::vector<std::string> out;
   std::istringstream in(output);
   for (std::string l; std::getline(in, l);)
@@ -31,7 +29,7 @@ std::vector<std::string> linesWith(const std::string& output, const std::string&
   return out;
 }
 
-std::size_t lineCount(const fs::path& p) {
+std::size_t fileLineCount(const fs::path& p) {
   std::ifstream in(p);
   std::size_t n = 0;
   for (std::string l; std::getline(in, l);) n += !l.empty() && l[0] != '#';  // data lines, not the header
@@ -39,9 +37,9 @@ std::size_t lineCount(const fs::path& p) {
 }
 
 // One [error] line naming `names`, exit 2.
-void expectOneError(const CliResult& r, const std::string& names) {
+void expectOneErrorNaming(const CliResult& r, const std::string& names) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  const auto errors = linesWith(r.output, "[error]");
+  const auto errors = taggedLines(r.output, "[error]");
   ASSERT_EQ(errors.size(), 1u) << r.output;
   EXPECT_TRUE(contains(errors[0], names)) << "the error should name " << names << ": " << errors[0];
 }
@@ -52,7 +50,7 @@ fs::path kittiSequence(const TempDir& dir) {
   return dir / "00";
 }
 
-std::string runKitti(const fs::path& seq, const fs::path& out) {
+std::string runKittiSequence(const fs::path& seq, const fs::path& out) {
   return "run " + seq.string() + " --format kitti --config " + config("kitti.yaml") + " --out " + out.string();
 }
 
@@ -67,7 +65,7 @@ TEST(ReadmePromises, EveryCommandReportsAMissingInputInOneErrorLineWithExitCode2
         "graph optimize " + none + " " + (dir / "o.g2o").string(), "features detect --detector orb " + none,
         "features track " + none + " --format euroc --out " + (dir / "t").string()}) {
     SCOPED_TRACE(args);
-    expectOneError(runDrover(args), none);
+    expectOneErrorNaming(runDrover(args), none);
   }
 }
 
@@ -82,7 +80,7 @@ TEST(ReadmePromises, QuietPrintsNothingOnGoodInputForEveryCommand) {
   for (const std::string& args :
        {"info " + seq.string() + " --format kitti -q",
         "sim --scenario straight --duration 0.5 --camera-rate 10 --out " + (dir / "sim").string() + " -q",
-        runKitti(seq, dir / "run") + " --max-frames 2 -q", "eval ape " + tum + " " + tum + " -q",
+        runKittiSequence(seq, dir / "run") + " --max-frames 2 -q", "eval ape " + tum + " " + tum + " -q",
         "loop pair " + scan + " " + scan + " -q", "loop eval " + seq.string() + " --format kitti -q",
         "graph optimize " + (dir / "g.g2o").string() + " " + (dir / "o.g2o").string() + " -q",
         "features detect --detector orb " + (dir / "board.png").string() + " -q",
@@ -100,7 +98,7 @@ TEST(ReadmePromises, InfoReportsAScanListedInTimesTxtButMissingAsAnError) {
   TempDir dir;
   const fs::path seq = kittiSequence(dir);
   fs::remove(seq / "velodyne" / "000005.bin");
-  expectOneError(runDrover("info " + seq.string() + " --format kitti"), "000005.bin");
+  expectOneErrorNaming(runDrover("info " + seq.string() + " --format kitti"), "000005.bin");
   EXPECT_EQ(runDrover("info " + seq.string() + " --format kitti --max-frames 5").exit_code, 0);
 }
 
@@ -110,10 +108,10 @@ TEST(ReadmePromises, SimRefusesAnExistingFolderWithoutForceAndReplacesADatasetWi
   const std::string sim = "sim -q --scenario straight --duration 0.3 --no-camera --out " + (dir / "ds").string();
   ASSERT_EQ(runDrover(sim).exit_code, 0);
   writeText(dir / "ds" / "marker.txt", "x");
-  expectOneError(runDrover(sim), (dir / "ds").string());
+  expectOneErrorNaming(runDrover(sim), (dir / "ds").string());
   EXPECT_TRUE(fs::exists(dir / "ds" / "marker.txt")) << "a refused sim touched the folder";
   // With a file of the user's in it the folder is no longer only a dataset: even --force keeps it.
-  expectOneError(runDrover(sim + " --force"), (dir / "ds").string());
+  expectOneErrorNaming(runDrover(sim + " --force"), (dir / "ds").string());
   EXPECT_TRUE(fs::exists(dir / "ds" / "marker.txt")) << "--force deleted a file that was not the dataset's";
   fs::remove(dir / "ds" / "marker.txt");
   EXPECT_EQ(runDrover(sim + " --force").exit_code, 0);
@@ -127,7 +125,7 @@ TEST(ReadmePromises, SimForceRefusesToReplaceAFolderThatIsNotADataset) {
   writeText(dir / "file.txt", "a plain file\n");
   for (const fs::path& target : {dir / "mine", dir / "file.txt"}) {
     SCOPED_TRACE(target.string());
-    expectOneError(runDrover("sim -q --scenario straight --duration 0.3 --no-camera --force --out " + target.string()),
+    expectOneErrorNaming(runDrover("sim -q --scenario straight --duration 0.3 --no-camera --force --out " + target.string()),
                    target.string());
   }
   EXPECT_TRUE(fs::exists(dir / "mine" / "thesis.tex"));
@@ -154,10 +152,10 @@ TEST(ReadmePromises, RunDropsNanAndInfPointsWithAWarningAndACounter) {
   scan[100][0] = std::numeric_limits<float>::quiet_NaN();
   scan[200][2] = std::numeric_limits<float>::infinity();
   writeBin(seq / "velodyne" / "000002.bin", scan);
-  const CliResult r = runDrover(runKitti(seq, dir / "run"));
+  const CliResult r = runDrover(runKittiSequence(seq, dir / "run"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_FALSE(linesWith(r.output, "[warning]").empty()) << "no warning for the dropped points:\n" << r.output;
-  EXPECT_EQ(lineCount(dir / "run" / "trajectory.tum"), 6u);
+  EXPECT_FALSE(taggedLines(r.output, "[warning]").empty()) << "no warning for the dropped points:\n" << r.output;
+  EXPECT_EQ(fileLineCount(dir / "run" / "trajectory.tum"), 6u);
   EXPECT_GE(readJson(dir / "run" / "report.json")["counts"]["points_dropped"].get<long>(), 2);
 }
 
@@ -167,11 +165,11 @@ TEST(ReadmePromises, RunSkipsAnEmptySweepWithAWarningAndKeepsOneKittiLinePerScan
   TempDir dir;
   const fs::path seq = kittiSequence(dir);
   writeText(seq / "velodyne" / "000003.bin", "");
-  const CliResult r = runDrover(runKitti(seq, dir / "run"));
+  const CliResult r = runDrover(runKittiSequence(seq, dir / "run"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_FALSE(linesWith(r.output, "[warning]").empty()) << r.output;
+  EXPECT_FALSE(taggedLines(r.output, "[warning]").empty()) << r.output;
   EXPECT_EQ(readJson(dir / "run" / "report.json")["counts"]["scans_skipped_empty"], 1);
-  EXPECT_EQ(lineCount(dir / "run" / "trajectory_kitti.txt"), 6u) << "one line per scan of times.txt";
+  EXPECT_EQ(fileLineCount(dir / "run" / "trajectory_kitti.txt"), 6u) << "one line per scan of times.txt";
 }
 
 // "A dataset without lidar sweeps is an error (exit 2)." -- and so is one where no sweep produced a pose
@@ -180,8 +178,8 @@ TEST(ReadmePromises, RunWithoutAnyUsableSweepIsAnError) {
   TempDir dir;
   const fs::path seq = kittiSequence(dir);
   for (int i = 0; i < 6; ++i) writeText(seq / "velodyne" / ("00000" + std::to_string(i) + ".bin"), "");
-  const CliResult r = runDrover(runKitti(seq, dir / "run"));
-  expectOneError(r, seq.string());
+  const CliResult r = runDrover(runKittiSequence(seq, dir / "run"));
+  expectOneErrorNaming(r, seq.string());
   EXPECT_FALSE(fs::exists(dir / "run" / "report.json"));
 }
 
@@ -230,7 +228,7 @@ TEST_F(SimImuPromise, AnImuGapIsBridgedCountedAndWarned) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_GE(readJson(ds.string() + "_run/report.json")["counts"]["imu"]["gaps"].get<int>(), 1);
   bool warned = false;
-  for (const auto& l : linesWith(r.output, "[warning]")) warned = warned || contains(l, "gap");
+  for (const auto& l : taggedLines(r.output, "[warning]")) warned = warned || contains(l, "gap");
   EXPECT_TRUE(warned) << "no warning names the IMU gap:\n" << r.output;
 }
 
@@ -250,7 +248,7 @@ TEST_F(SimImuPromise, AnImuSpikeIsDroppedCountedAndWarned) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_GE(readJson(ds.string() + "_run/report.json")["counts"]["imu"]["dropped_spike"].get<int>(), 1);
   bool warned = false;
-  for (const auto& l : linesWith(r.output, "[warning]")) warned = warned || contains(l, "spike");
+  for (const auto& l : taggedLines(r.output, "[warning]")) warned = warned || contains(l, "spike");
   EXPECT_TRUE(warned) << "no warning names the IMU spike:\n" << r.output;
 }
 
@@ -273,7 +271,7 @@ TEST_F(SimImuPromise, ASweepWhoseStampDoesNotAdvanceIsSkippedWithAWarning) {
   writeText(ds / "lidar" / "timestamps.csv", text);
   const CliResult r = run(ds);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_FALSE(linesWith(r.output, "[warning]").empty()) << r.output;
+  EXPECT_FALSE(taggedLines(r.output, "[warning]").empty()) << r.output;
   // The reader drops the repeated stamp (a measurement that does not advance on its own sensor), so the odometry
   // never sees it.
   EXPECT_EQ(readJson(ds.string() + "_run/report.json")["counts"]["measurements_dropped"], 1);

@@ -15,8 +15,6 @@ namespace drover::test {
 namespace {
 namespace fs = std::filesystem;
 
-std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
-
 // Exit 2 with one [error] line that holds every fragment.
 void expectOneError(const CliResult& r, std::initializer_list<std::string> fragments) {
   EXPECT_EQ(r.exit_code, 2) << r.output;

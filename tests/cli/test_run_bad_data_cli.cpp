@@ -24,15 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
-
-std::vector<std::string> linesOf(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) out.push_back(l);
-  return out;
-}
-
 std::vector<std::string> linesWith(const std::string& output, const std::string& part) {
   std::vector<std::string> out;
   for (const std::string& l : linesOf(output))

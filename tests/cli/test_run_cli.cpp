@@ -24,15 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
-
-std::vector<std::string> linesOf(const std::string& text) {
-  std::vector<std::string> out;
-  std::istringstream in(text);
-  for (std::string l; std::getline(in, l);) out.push_back(l);
-  return out;
-}
-
 // The lines spdlog printed at error level.
 std::vector<std::string> errorLines(const std::string& output) {
   std::vector<std::string> out;

@@ -22,8 +22,6 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
-
 int lineCount(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 // Records of a text file of the simulated folder (lines not starting with '#').

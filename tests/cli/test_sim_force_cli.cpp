@@ -25,7 +25,7 @@ std::set<std::string> namesIn(const fs::path& dir) {
 }
 
 // One `[error] OUT (--out): ...` line naming WHY, exit code 2, no simulation started.
-void expectRefused(const CliResult& r, const std::string& out, const std::string& why) {
+void expectSimRefused(const CliResult& r, const std::string& out, const std::string& why) {
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
   EXPECT_EQ(r.output.rfind("[error] " + out + " (--out): ", 0), 0u) << r.output;
@@ -42,8 +42,8 @@ fs::path makeDataset(const fs::path& out, const std::string& extra = "") {
 TEST(SimForceCli, RefusesTheWorkingFolderAndDeletesNothing) {
   TempDir dir;
   writeText(dir / "keep.txt", "mine");
-  expectRefused(runDroverIn(dir.path(), kSim + "--force --out ."), ".", "is the working folder");
-  expectRefused(runDroverIn(dir.path(), kSim + "--force --out ./"), "./", "is the working folder");
+  expectSimRefused(runDroverIn(dir.path(), kSim + "--force --out ."), ".", "is the working folder");
+  expectSimRefused(runDroverIn(dir.path(), kSim + "--force --out ./"), "./", "is the working folder");
   EXPECT_EQ(namesIn(dir.path()), std::set<std::string>{"keep.txt"});
 }
 
@@ -52,10 +52,10 @@ TEST(SimForceCli, RefusesTheParentAndAnyAncestorOfTheWorkingFolderWithOrWithoutA
   writeText(dir / "a" / "keep.txt", "mine");
   fs::create_directories(dir / "a" / "b" / "c");
   const fs::path cwd = dir / "a" / "b" / "c";
-  expectRefused(runDroverIn(cwd, kSim + "--force --out .."), "..", "is an ancestor of the working folder");
-  expectRefused(runDroverIn(cwd, kSim + "--force --out ../../"), "../../", "is an ancestor of the working folder");
+  expectSimRefused(runDroverIn(cwd, kSim + "--force --out .."), "..", "is an ancestor of the working folder");
+  expectSimRefused(runDroverIn(cwd, kSim + "--force --out ../../"), "../../", "is an ancestor of the working folder");
   const std::string a = (dir / "a").string() + "/";
-  expectRefused(runDroverIn(cwd, kSim + "--force --out " + a), a, "is an ancestor of the working folder");
+  expectSimRefused(runDroverIn(cwd, kSim + "--force --out " + a), a, "is an ancestor of the working folder");
   EXPECT_EQ(namesIn(dir / "a"), (std::set<std::string>{"keep.txt", "b", "b/c"}));
 }
 
@@ -63,7 +63,7 @@ TEST(SimForceCli, RefusesTheHomeFolderEvenWhenItHoldsADataset) {
   TempDir dir;
   const fs::path home = makeDataset(dir / "home");
   const std::set<std::string> before = namesIn(home);
-  expectRefused(runDroverIn(dir.path(), kSim + "--force --out " + home.string(), "HOME=" + home.string()),
+  expectSimRefused(runDroverIn(dir.path(), kSim + "--force --out " + home.string(), "HOME=" + home.string()),
                 home.string(), "is the home folder");
   EXPECT_EQ(namesIn(home), before);
 }
@@ -72,13 +72,13 @@ TEST(SimForceCli, RefusesAFolderThatIsNotADatasetAndADatasetWithAUserFileAdded) 
   TempDir dir;
   writeText(dir / "mine" / "notes.txt", "mine");
   const std::string mine = (dir / "mine").string();
-  expectRefused(runDrover(kSim + "--force --out " + mine), mine, "is not a complete simulated dataset");
+  expectSimRefused(runDrover(kSim + "--force --out " + mine), mine, "is not a complete simulated dataset");
   EXPECT_EQ(namesIn(dir / "mine"), std::set<std::string>{"notes.txt"});
 
   const fs::path ds = makeDataset(dir / "ds");
   writeText(ds / "lidar" / "labels.txt", "mine");
   const std::set<std::string> before = namesIn(ds);
-  expectRefused(runDrover(kSim + "--force --out " + ds.string()), ds.string(),
+  expectSimRefused(runDrover(kSim + "--force --out " + ds.string()), ds.string(),
                 "holds lidar/labels.txt, which drover sim does not write");
   EXPECT_EQ(namesIn(ds), before);
 }
@@ -87,13 +87,13 @@ TEST(SimForceCli, RefusesAPlainFileAndALinkToADataset) {
   TempDir dir;
   writeText(dir / "file.txt", "mine");
   const std::string file = (dir / "file.txt").string();
-  expectRefused(runDrover(kSim + "--force --out " + file), file, "is a file, not a folder");
+  expectSimRefused(runDrover(kSim + "--force --out " + file), file, "is a file, not a folder");
   EXPECT_EQ(readText(dir / "file.txt"), "mine");
 
   const fs::path ds = makeDataset(dir / "ds");
   fs::create_directory_symlink(ds, dir / "link");
   const std::string link = (dir / "link").string();
-  expectRefused(runDrover(kSim + "--force --out " + link), link, "is a symbolic link");
+  expectSimRefused(runDrover(kSim + "--force --out " + link), link, "is a symbolic link");
   EXPECT_TRUE(fs::is_symlink(dir / "link"));
   EXPECT_TRUE(fs::exists(ds / "calibration.yaml"));
 }

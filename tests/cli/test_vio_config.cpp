@@ -13,15 +13,9 @@
 namespace drover::test {
 namespace {
 
-std::string write(const TempDir& dir, const std::string& yaml) {
-  const auto p = dir / "platform.yaml";
-  writeText(p, yaml);
-  return p.string();
-}
-
 TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
   TempDir dir;
-  const vio::VioConfig c = io::loadVioConfig(write(dir, R"(vio:
+  const vio::VioConfig c = io::loadVioConfig(writePlatformFile(dir, R"(vio:
   window: 7
   min_parallax_px: 12.5
   max_keyframe_interval_s: 0.75
@@ -91,7 +85,7 @@ TEST(VioConfigIo, KeysReachTheConfigWithTheirUnits) {
 
 TEST(VioConfigIo, AFileWithoutTheSectionGivesTheDefaults) {
   TempDir dir;
-  const vio::VioConfig c = io::loadVioConfig(write(dir, "odometry:\n  use_imu: true\n"));
+  const vio::VioConfig c = io::loadVioConfig(writePlatformFile(dir, "odometry:\n  use_imu: true\n"));
   EXPECT_EQ(c.window, vio::VioConfig{}.window);
   EXPECT_EQ(c.depth_mode, vio::DepthMode::kFixed);
 }
@@ -104,7 +98,7 @@ TEST(VioConfigIo, ANegativeSeedThresholdOrNoObservationsIsAnErrorNamingTheValue)
            {"vio:\n  lis_bias_prior_sigma_acc: 0.02\n", "both 0 (off) or both > 0"},
            {"vio:\n  lis_bias_prior_sigma_gyro: -1\n  lis_bias_prior_sigma_acc: 0.02\n", "must be >= 0"}}) {
     SCOPED_TRACE(yaml);
-    const std::string path = write(dir, yaml);
+    const std::string path = writePlatformFile(dir, yaml);
     test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", words});
   }
 }
@@ -132,7 +126,7 @@ TEST(VioConfigIo, AnUnknownKeyABadChoiceOrAnInvalidValueNamesTheFileLineAndKey) 
            {"vio:\n  ground_check_min_points: 2\n", "ground_check_min_points >= 3"},
            {"vio:\n  ground_check_cluster_rel: 0.5\n", "ground_check_cluster_rel in (0, 0.5)"}}) {
     SCOPED_TRACE(yaml);
-    const std::string path = write(dir, yaml);
+    const std::string path = writePlatformFile(dir, yaml);
     test::expectIoError([&] { io::loadVioConfig(path); }, {"platform.yaml", "line", words});
   }
 }

@@ -15,17 +15,17 @@ namespace {
 
 using visual::DetectorType;
 
-std::string shipped(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
+std::string shippedConfig(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
 
-VisualConfig load(const test::TempDir& dir, const std::string& text) {
+VisualConfig loadVisual(const test::TempDir& dir, const std::string& text) {
   const auto path = dir / "visual.yaml";
   test::writeText(path, text);
   return loadVisualConfig(path.string());
 }
 
-std::string errorOf(const test::TempDir& dir, const std::string& text) {
+std::string visualErrorOf(const test::TempDir& dir, const std::string& text) {
   try {
-    load(dir, text);
+    loadVisual(dir, text);
   } catch (const IoError& e) {
     return e.what();
   }
@@ -33,31 +33,31 @@ std::string errorOf(const test::TempDir& dir, const std::string& text) {
   return {};
 }
 
-bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool hasPart(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 TEST(VisualConfigReader, ShippedConfigsChooseSuperPointWithTheSharedWeights) {
   for (const char* name : {"kitti.yaml", "euroc.yaml", "farm_sim.yaml"}) {
     SCOPED_TRACE(name);
     VisualConfig c;
-    ASSERT_NO_THROW(c = loadVisualConfig(shipped(name)));
+    ASSERT_NO_THROW(c = loadVisualConfig(shippedConfig(name)));
     EXPECT_EQ(c.detector.type, DetectorType::kSuperPoint);
     EXPECT_EQ(c.detector.superpoint.weights, "../shared/models/superpoint_v1.onnx");
     EXPECT_EQ(c.detector.validate(), "");
   }
-  EXPECT_DOUBLE_EQ(loadVisualConfig(shipped("euroc.yaml")).detector.shi_tomasi.min_dist, 30.0);
-  EXPECT_EQ(loadVisualConfig(shipped("kitti.yaml")).detector.shi_tomasi.max_cnt, 200);
+  EXPECT_DOUBLE_EQ(loadVisualConfig(shippedConfig("euroc.yaml")).detector.shi_tomasi.min_dist, 30.0);
+  EXPECT_EQ(loadVisualConfig(shippedConfig("kitti.yaml")).detector.shi_tomasi.max_cnt, 200);
 }
 
 TEST(VisualConfigReader, AFileWithoutAVisualSectionGivesTheDefaults) {
   test::TempDir dir;
-  const VisualConfig c = load(dir, "dataset:\n  load_images: true\n");
+  const VisualConfig c = loadVisual(dir, "dataset:\n  load_images: true\n");
   EXPECT_EQ(c.detector.type, DetectorType::kSuperPoint);
   EXPECT_EQ(c.detector.shi_tomasi.max_cnt, visual::ShiTomasiConfig{}.max_cnt);
 }
 
 TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
   test::TempDir dir;
-  const VisualConfig c = load(dir, R"(visual:
+  const VisualConfig c = loadVisual(dir, R"(visual:
   detector:
     type: orb
     shi_tomasi: {max_cnt: 11, min_dist: 12.5, quality_level: 0.013, block_size: 5}
@@ -97,39 +97,39 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
 
 TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {
   test::TempDir dir;
-  std::string e = errorOf(dir, "visual:\n  detector:\n    superpoint:\n      weigths: x.onnx\n");
-  EXPECT_TRUE(has(e, "visual.yaml")) << e;
-  EXPECT_TRUE(has(e, "line 4")) << e;
-  EXPECT_TRUE(has(e, "visual.detector.superpoint.weigths")) << e;
-  e = errorOf(dir, "visual:\n  detector:\n    type: sift\n");
-  EXPECT_TRUE(has(e, "line 3")) << e;
-  EXPECT_TRUE(has(e, "superpoint, shi-tomasi or orb")) << e;
-  e = errorOf(dir, "visual:\n  detector:\n    orb:\n      n_levels: many\n");
-  EXPECT_TRUE(has(e, "line 4")) << e;
-  EXPECT_TRUE(has(e, "visual.detector.orb.n_levels")) << e;
-  e = errorOf(dir, "visual:\n  detectors: {}\n");
-  EXPECT_TRUE(has(e, "visual.detectors")) << e;
+  std::string e = visualErrorOf(dir, "visual:\n  detector:\n    superpoint:\n      weigths: x.onnx\n");
+  EXPECT_TRUE(hasPart(e, "visual.yaml")) << e;
+  EXPECT_TRUE(hasPart(e, "line 4")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.detector.superpoint.weigths")) << e;
+  e = visualErrorOf(dir, "visual:\n  detector:\n    type: sift\n");
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
+  EXPECT_TRUE(hasPart(e, "superpoint, shi-tomasi or orb")) << e;
+  e = visualErrorOf(dir, "visual:\n  detector:\n    orb:\n      n_levels: many\n");
+  EXPECT_TRUE(hasPart(e, "line 4")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.detector.orb.n_levels")) << e;
+  e = visualErrorOf(dir, "visual:\n  detectors: {}\n");
+  EXPECT_TRUE(hasPart(e, "visual.detectors")) << e;
 }
 
 TEST(VisualConfigReader, ValuesThatFailValidationNameTheSectionAndItsLine) {
   test::TempDir dir;
-  std::string e = errorOf(dir,
+  std::string e = visualErrorOf(dir,
                           "visual:\n  detector:\n    type: orb\n    superpoint:\n      input_width: 100\n"
                           "      input_height: 80\n");
-  EXPECT_TRUE(has(e, "line 5")) << e;  // yaml-cpp marks a map by its first key
-  EXPECT_TRUE(has(e, "visual.detector.superpoint")) << e;
-  EXPECT_TRUE(has(e, "multiples of 8")) << e;
-  e = errorOf(dir, "visual:\n  detector:\n    shi_tomasi:\n      quality_level: 1.5\n");
-  EXPECT_TRUE(has(e, "visual.detector.shi_tomasi")) << e;
-  EXPECT_TRUE(has(e, "quality_level")) << e;
-  e = errorOf(dir, "visual:\n  detector:\n    orb: {scale_factor: 0.9}\n");
-  EXPECT_TRUE(has(e, "line 3")) << e;
-  EXPECT_TRUE(has(e, "scale_factor")) << e;
+  EXPECT_TRUE(hasPart(e, "line 5")) << e;  // yaml-cpp marks a map by its first key
+  EXPECT_TRUE(hasPart(e, "visual.detector.superpoint")) << e;
+  EXPECT_TRUE(hasPart(e, "multiples of 8")) << e;
+  e = visualErrorOf(dir, "visual:\n  detector:\n    shi_tomasi:\n      quality_level: 1.5\n");
+  EXPECT_TRUE(hasPart(e, "visual.detector.shi_tomasi")) << e;
+  EXPECT_TRUE(hasPart(e, "quality_level")) << e;
+  e = visualErrorOf(dir, "visual:\n  detector:\n    orb: {scale_factor: 0.9}\n");
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
+  EXPECT_TRUE(hasPart(e, "scale_factor")) << e;
 }
 
 TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
   test::TempDir dir;
-  const VisualConfig c = load(dir, R"(visual:
+  const VisualConfig c = loadVisual(dir, R"(visual:
   tracker:
     max_features: 40
     min_distance: 12.5
@@ -192,13 +192,13 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
   EXPECT_DOUBLE_EQ(d.min_depth, 3);
   EXPECT_DOUBLE_EQ(d.max_depth, 80);
   EXPECT_DOUBLE_EQ(d.min_incidence_cos, 0.1);
-  EXPECT_EQ(load(dir, "visual:\n  tracker: {clahe: 'off'}\n").tracker.clahe, visual::ClaheMode::kOff);
+  EXPECT_EQ(loadVisual(dir, "visual:\n  tracker: {clahe: 'off'}\n").tracker.clahe, visual::ClaheMode::kOff);
 }
 
 TEST(VisualConfigReader, ShippedConfigsGiveTheTrackerAndDepthDefaults) {
   for (const char* name : {"kitti.yaml", "euroc.yaml", "farm_sim.yaml"}) {
     SCOPED_TRACE(name);
-    const VisualConfig c = loadVisualConfig(shipped(name));
+    const VisualConfig c = loadVisualConfig(shippedConfig(name));
     const visual::FeatureTrackerConfig t;
     EXPECT_EQ(c.tracker.max_features, t.max_features);
     EXPECT_DOUBLE_EQ(c.tracker.forward_backward_px, t.forward_backward_px);
@@ -214,49 +214,49 @@ TEST(VisualConfigReader, ShippedConfigsGiveTheTrackerAndDepthDefaults) {
 
 TEST(VisualConfigReader, TrackerAndDepthMistakesNameFileLineAndKey) {
   test::TempDir dir;
-  std::string e = errorOf(dir, "visual:\n  tracker:\n    max_features: 100\n    max_feature: 40\n");
-  EXPECT_TRUE(has(e, "visual.yaml")) << e;
-  EXPECT_TRUE(has(e, "line 4")) << e;
-  EXPECT_TRUE(has(e, "visual.tracker.max_feature")) << e;
-  e = errorOf(dir, "visual:\n  depth:\n    window: 5\n");
-  EXPECT_TRUE(has(e, "line 3")) << e;
-  EXPECT_TRUE(has(e, "visual.depth.window")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    forward_backward_px: wide\n");
-  EXPECT_TRUE(has(e, "line 3")) << e;
-  EXPECT_TRUE(has(e, "visual.tracker.forward_backward_px")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    clahe: sometimes\n");
-  EXPECT_TRUE(has(e, "line 3")) << e;
-  EXPECT_TRUE(has(e, "off, always or when_dark")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    flow_window: 20\n");  // parses, fails validate()
-  EXPECT_TRUE(has(e, "line 3")) << e;
-  EXPECT_TRUE(has(e, "visual.tracker")) << e;
-  EXPECT_TRUE(has(e, "flow_window must be odd")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    min_eigenvalue: -0.001\n");
-  EXPECT_TRUE(has(e, "line 3") && has(e, "min_eigenvalue must be finite and >= 0")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    detect_interval_s: -1\n");
-  EXPECT_TRUE(has(e, "line 3") && has(e, "detect_interval_s must be in [0, 60] s")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    detect_sync_below: -1\n");
-  EXPECT_TRUE(has(e, "line 3") && has(e, "detect_sync_below must be >= 0")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    top_up_below: -5\n");
-  EXPECT_TRUE(has(e, "line 3") && has(e, "top_up_below must be >= 0")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    top_up_below: many\n");
-  EXPECT_TRUE(has(e, "line 3") && has(e, "visual.tracker.top_up_below")) << e;
-  e = errorOf(dir, "visual:\n  tracker:\n    top_up_min_eigenvalue: -1e-4\n");
-  EXPECT_TRUE(has(e, "line 3") && has(e, "top_up_min_eigenvalue must be finite and >= 0")) << e;
-  e = errorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
-  EXPECT_TRUE(has(e, "visual.depth")) << e;
-  EXPECT_TRUE(has(e, "line 3")) << e;
+  std::string e = visualErrorOf(dir, "visual:\n  tracker:\n    max_features: 100\n    max_feature: 40\n");
+  EXPECT_TRUE(hasPart(e, "visual.yaml")) << e;
+  EXPECT_TRUE(hasPart(e, "line 4")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.tracker.max_feature")) << e;
+  e = visualErrorOf(dir, "visual:\n  depth:\n    window: 5\n");
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.depth.window")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    forward_backward_px: wide\n");
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.tracker.forward_backward_px")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    clahe: sometimes\n");
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
+  EXPECT_TRUE(hasPart(e, "off, always or when_dark")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    flow_window: 20\n");  // parses, fails validate()
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.tracker")) << e;
+  EXPECT_TRUE(hasPart(e, "flow_window must be odd")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    min_eigenvalue: -0.001\n");
+  EXPECT_TRUE(hasPart(e, "line 3") && hasPart(e, "min_eigenvalue must be finite and >= 0")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    detect_interval_s: -1\n");
+  EXPECT_TRUE(hasPart(e, "line 3") && hasPart(e, "detect_interval_s must be in [0, 60] s")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    detect_sync_below: -1\n");
+  EXPECT_TRUE(hasPart(e, "line 3") && hasPart(e, "detect_sync_below must be >= 0")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    top_up_below: -5\n");
+  EXPECT_TRUE(hasPart(e, "line 3") && hasPart(e, "top_up_below must be >= 0")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    top_up_below: many\n");
+  EXPECT_TRUE(hasPart(e, "line 3") && hasPart(e, "visual.tracker.top_up_below")) << e;
+  e = visualErrorOf(dir, "visual:\n  tracker:\n    top_up_min_eigenvalue: -1e-4\n");
+  EXPECT_TRUE(hasPart(e, "line 3") && hasPart(e, "top_up_min_eigenvalue must be finite and >= 0")) << e;
+  e = visualErrorOf(dir, "visual:\n  depth:\n    min_depth: 5\n    max_depth: 2\n");
+  EXPECT_TRUE(hasPart(e, "visual.depth")) << e;
+  EXPECT_TRUE(hasPart(e, "line 3")) << e;
 }
 
 TEST(VisualConfigReader, RelativeWeightsAreTheWorkingDirectorysElseTheOnesBesideTheConfig) {
   test::TempDir dir;
   test::writeText(dir / "own_superpoint.onnx", "not a network: only its place matters here");
   const std::string beside = (dir / "own_superpoint.onnx").lexically_normal().string();
-  EXPECT_EQ(load(dir, "visual:\n  detector:\n    superpoint:\n      weights: own_superpoint.onnx\n")
+  EXPECT_EQ(loadVisual(dir, "visual:\n  detector:\n    superpoint:\n      weights: own_superpoint.onnx\n")
                 .detector.superpoint.weights,
             beside);
   // Found nowhere: left as written, for the detector's error to name.
-  EXPECT_EQ(load(dir, "visual:\n  detector:\n    superpoint:\n      weights: no_such.onnx\n")
+  EXPECT_EQ(loadVisual(dir, "visual:\n  detector:\n    superpoint:\n      weights: no_such.onnx\n")
                 .detector.superpoint.weights,
             "no_such.onnx");
   // Found in the working directory: that one, as the shipped configs' paths are meant.
@@ -264,7 +264,7 @@ TEST(VisualConfigReader, RelativeWeightsAreTheWorkingDirectorysElseTheOnesBeside
   const std::string there = (cwd_file / "w.onnx").string();
   test::writeText(cwd_file / "w.onnx", "x");
   const std::string relative = std::filesystem::relative(there).string();
-  EXPECT_EQ(load(dir, "visual:\n  detector:\n    superpoint:\n      weights: " + relative + "\n")
+  EXPECT_EQ(loadVisual(dir, "visual:\n  detector:\n    superpoint:\n      weights: " + relative + "\n")
                 .detector.superpoint.weights,
             relative);
 }

@@ -6,11 +6,12 @@
 #include <vector>
 
 #include "eval/association.hpp"
+#include "support/units.hpp"
 
 namespace drover::eval {
 namespace {
 
-constexpr Time kMs = 1'000'000;
+using ::drover::test::kMs;
 
 Trajectory stamps(const std::vector<Time>& ts) {
   Trajectory t;

@@ -14,7 +14,7 @@
 namespace drover::test::fuzz {
 namespace {
 
-std::string readDataset(const fs::path& dir, const std::string& format) {
+std::string readKittiDataset(const fs::path& dir, const std::string& format) {
   auto reader = io::openDataset(dir.string(), format, io::DatasetOptions{});
   return checkStream(*reader, true);
 }
@@ -30,7 +30,7 @@ TEST(FuzzKittiOdometry, MutatedSequencesReadCleanlyOrFailWithOneIoErrorNamingThe
              {"00/velodyne/000000.bin", true, 16},
              {"00/velodyne/000002.bin", true, 16},
              {"00/image_2/000001.png", true, 1}};
-  t.read = [](const fs::path& root) { return readDataset(root / "00", "kitti"); };
+  t.read = [](const fs::path& root) { return readKittiDataset(root / "00", "kitti"); };
   // Item 9 of issue 14: one NaN point (README: "NaN/inf points are dropped").
   std::string bin, calib;  // from a scratch copy of the fixture
   TempDir scratch;
@@ -67,7 +67,7 @@ TEST(FuzzKittiRaw, MutatedDrivesReadCleanlyOrFailWithOneIoErrorNamingTheFile) {
              {d + "calib_cam_to_cam.txt"},
              {d + "image_02/timestamps.txt"},
              {d + "image_02/data/0000000000.png", true, 1}};
-  t.read = [d](const fs::path& root) { return readDataset(root / d, "kitti-raw"); };
+  t.read = [d](const fs::path& root) { return readKittiDataset(root / d, "kitti-raw"); };
   runCampaign(t, 400);
 }
 

@@ -17,7 +17,7 @@ Vector6d randomTwist(std::mt19937& rng, double rot_scale, double trans_scale) {
 }
 
 template <typename F>
-Matrix6d numericalJacobian(F f, const Vector6d& x, double h = 1e-6) {
+Matrix6d numericalJacobianSe3(F f, const Vector6d& x, double h = 1e-6) {
   Matrix6d J;
   for (int i = 0; i < 6; ++i) {
     Vector6d e = Vector6d::Zero();
@@ -80,7 +80,7 @@ TEST(SE3, RightJacobianMatchesNumericalDerivativeOfExp) {
       const Vector6d xi = randomTwist(rng, rs, 2.0);
       const Eigen::Isometry3d T0inv = inverse(expSE3(xi));
       auto f = [&](const Vector6d& x) { return logSE3(T0inv * expSE3(x)); };
-      EXPECT_LT((rightJacobianSE3(xi) - numericalJacobian(f, xi)).norm(), 1e-6) << xi.transpose();
+      EXPECT_LT((rightJacobianSE3(xi) - numericalJacobianSe3(f, xi)).norm(), 1e-6) << xi.transpose();
     }
   }
 }

@@ -10,12 +10,9 @@
 #include <string>
 #include <vector>
 
-namespace drover::test {
+#include "support/temp_dir.hpp"
 
-inline std::string readText(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+namespace drover::test {
 
 using RawPoint = std::array<float, 4>;  // x, y, z, reflectance
 

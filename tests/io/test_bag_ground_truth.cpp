@@ -10,12 +10,13 @@
 #include "io/ros_serialize.hpp"
 #include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
+#include "support/units.hpp"
 
 namespace drover::io {
 namespace {
 
 constexpr Time kT0 = Time{1'700'000'000} * kNanosPerSecond;
-constexpr Time kMs = 1'000'000;
+using ::drover::test::kMs;
 
 ros::Odometry odometry(Time t, const std::string& child = "imu") {
   ros::Odometry o;

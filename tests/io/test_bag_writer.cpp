@@ -20,14 +20,15 @@
 #include "io/fixtures/read_bag.hpp"
 #include "support/expect_io_error.hpp"
 #include "support/temp_dir.hpp"
+#include "support/units.hpp"
 
 namespace drover::io {
 namespace {
 namespace fs = std::filesystem;
 using test::TempDir;
 
-constexpr Time kT0 = Time{1'600'000'000} * kNanosPerSecond + 123'456'789;  // any Unix time with odd nanoseconds
-constexpr Time kMs = 1'000'000;
+constexpr Time kWriterT0 = Time{1'600'000'000} * kNanosPerSecond + 123'456'789;  // any Unix time with odd nanoseconds
+using ::drover::test::kMs;
 
 LidarScan makeScan(Time t, int k) {
   LidarScan s;
@@ -99,19 +100,19 @@ Written writeTestBag(const fs::path& path, std::uint32_t chunk_bytes) {
   const std::uint32_t gt = writer.addConnection("/ground_truth", ros::odometryType());
   std::vector<std::tuple<Time, int, std::uint32_t, std::string>> messages;  // record time, order, connection, data
   for (int k = 0; k < 100; ++k) {
-    w.imu.push_back(makeImu(kT0 + k * 10 * kMs, k));
+    w.imu.push_back(makeImu(kWriterT0 + k * 10 * kMs, k));
     messages.emplace_back(w.imu.back().t, 1, imu, ros::serializeImu(w.imu.back(), k, "imu", {1e-6, 4e-4}));
   }
   for (int k = 0; k < 10; ++k) {
-    w.scans.push_back(makeScan(kT0 + k * 100 * kMs, k));
+    w.scans.push_back(makeScan(kWriterT0 + k * 100 * kMs, k));
     messages.emplace_back(w.scans.back().t_end, 0, lidar, ros::serializePointCloud2(w.scans.back(), k, "lidar"));
   }
   for (int k = 0; k < 5; ++k) {
-    w.frames.push_back(makeFrame(kT0 + 5 * kMs + k * 200 * kMs, k));
+    w.frames.push_back(makeFrame(kWriterT0 + 5 * kMs + k * 200 * kMs, k));
     messages.emplace_back(w.frames.back().t, 2, image, ros::serializeImage(w.frames.back(), k, "camera"));
   }
   for (int k = 0; k < 50; ++k) {
-    w.gt.push_back(makeOdometry(kT0 + k * 20 * kMs, k));
+    w.gt.push_back(makeOdometry(kWriterT0 + k * 20 * kMs, k));
     messages.emplace_back(w.gt.back().t, 3, gt, ros::serializeOdometry(w.gt.back(), k));
   }
   std::stable_sort(messages.begin(), messages.end(), [](const auto& a, const auto& b) {
@@ -209,7 +210,7 @@ TEST(BagWriter, DebiansRosbagReadsTopicsCountsDefinitionsAndFieldsAndRosbagInfoA
   EXPECT_EQ(j["messages"], 165);
   EXPECT_EQ(j["read"], 165) << "every message deserializes";
   EXPECT_TRUE(j["read_in_time_order"].get<bool>());
-  EXPECT_NEAR(j["start_ns"].get<double>(), static_cast<double>(kT0), 1e3);
+  EXPECT_NEAR(j["start_ns"].get<double>(), static_cast<double>(kWriterT0), 1e3);
   const nlohmann::json& t = j["topics"];
   ASSERT_EQ(t.size(), 4u);
   const std::pair<const char*, const ros::MessageType*> types[] = {{"/points_raw", &ros::pointCloud2Type()},
@@ -228,7 +229,7 @@ TEST(BagWriter, DebiansRosbagReadsTopicsCountsDefinitionsAndFieldsAndRosbagInfoA
   EXPECT_EQ(t["/ground_truth"]["count"], 50);
 
   const nlohmann::json& cloud = t["/points_raw"]["first"];
-  EXPECT_EQ(cloud["header"]["stamp"].get<Time>(), kT0);
+  EXPECT_EQ(cloud["header"]["stamp"].get<Time>(), kWriterT0);
   EXPECT_EQ(t["/points_raw"]["first_record_ns"].get<Time>(), w.scans[0].t_end) << "recorded at its last point";
   EXPECT_EQ(cloud["header"]["frame_id"], "lidar");
   EXPECT_EQ(cloud["height"], 1);
@@ -281,9 +282,9 @@ TEST(BagWriter, ARecordTimeBeforeThePreviousOneIsRefusedNamingTheTopic) {
   TempDir dir;
   bag::BagWriter writer((dir / "a.bag").string());
   const std::uint32_t imu = writer.addConnection("/imu_raw", ros::imuType());
-  writer.write(imu, kT0, ros::serializeImu(makeImu(kT0, 0), 0, "imu"));
+  writer.write(imu, kWriterT0, ros::serializeImu(makeImu(kWriterT0, 0), 0, "imu"));
   try {
-    writer.write(imu, kT0 - 1, ros::serializeImu(makeImu(kT0 - 1, 1), 1, "imu"));
+    writer.write(imu, kWriterT0 - 1, ros::serializeImu(makeImu(kWriterT0 - 1, 1), 1, "imu"));
     FAIL() << "expected std::invalid_argument";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("/imu_raw"), std::string::npos) << e.what();
@@ -297,7 +298,7 @@ TEST(BagWriter, AWriterDestroyedBeforeFinishLeavesNeitherTheBagNorThePartialFile
   {
     bag::BagWriter writer((dir / "a.bag").string());
     const std::uint32_t imu = writer.addConnection("/imu_raw", ros::imuType());
-    writer.write(imu, kT0, ros::serializeImu(makeImu(kT0, 0), 0, "imu"));
+    writer.write(imu, kWriterT0, ros::serializeImu(makeImu(kWriterT0, 0), 0, "imu"));
     EXPECT_TRUE(fs::exists(dir / "a.bag.partial"));
   }
   EXPECT_FALSE(fs::exists(dir / "a.bag"));
@@ -312,7 +313,7 @@ TEST(BagWriter, ThePartialFileOfAKilledWriterIsAnUnindexedBagOfItsCompleteChunks
   const std::uint32_t imu = writer.addConnection("/imu_raw", ros::imuType());
   int written = 0;
   const auto writeOne = [&] {
-    const Time t = kT0 + written * kMs;
+    const Time t = kWriterT0 + written * kMs;
     writer.write(imu, t, ros::serializeImu(makeImu(t, written), written, "imu"));
     ++written;
   };
@@ -325,7 +326,7 @@ TEST(BagWriter, ThePartialFileOfAKilledWriterIsAnUnindexedBagOfItsCompleteChunks
   EXPECT_NE(reader.warnings()[0].find("not indexed"), std::string::npos) << reader.warnings()[0];
   int n = 0;
   while (auto m = reader.next()) {
-    EXPECT_EQ(measurementTime(*m), kT0 + n * kMs);
+    EXPECT_EQ(measurementTime(*m), kWriterT0 + n * kMs);
     ++n;
   }
   EXPECT_EQ(n, flushed) << "the messages of the complete chunks, not those of the open one";

@@ -89,7 +89,7 @@ class EurocFixture : public ::testing::Test {
   test::TempDir dir_;
 };
 
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+bool hasText(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 TEST_F(EurocFixture, MergesImuAndImagesInTimeOrderImuFirstOnTies) {
   auto reader = openEuroc(seq(), DatasetOptions{});
@@ -183,21 +183,21 @@ TEST_F(EurocFixture, RejectsAMissingFolder) {
     openEuroc(missing, DatasetOptions{});
     FAIL() << "expected an IoError";
   } catch (const IoError& e) {
-    EXPECT_TRUE(contains(e.what(), missing)) << e.what();
+    EXPECT_TRUE(hasText(e.what(), missing)) << e.what();
   }
 }
 
 TEST_F(EurocFixture, RejectsAFolderWithoutMav0) {
   fs::remove_all(path("mav0"));
   fs::create_directories(path("other"));
-  EXPECT_TRUE(contains(errorOf(), "no mav0/"));
+  EXPECT_TRUE(hasText(errorOf(), "no mav0/"));
 }
 
 TEST_F(EurocFixture, RejectsAMissingSensorYaml) {
   fs::remove(path("mav0/imu0/sensor.yaml"));
   const std::string msg = errorOf();
-  EXPECT_TRUE(contains(msg, "imu0/sensor.yaml")) << msg;
-  EXPECT_TRUE(contains(msg, "not found")) << msg;
+  EXPECT_TRUE(hasText(msg, "imu0/sensor.yaml")) << msg;
+  EXPECT_TRUE(hasText(msg, "not found")) << msg;
 }
 
 TEST_F(EurocFixture, RejectsASensorYamlWithoutIntrinsics) {
@@ -205,9 +205,9 @@ TEST_F(EurocFixture, RejectsASensorYamlWithoutIntrinsics) {
   cam.erase(cam.find("intrinsics:"), cam.find('\n', cam.find("intrinsics:")) - cam.find("intrinsics:") + 1);
   write("mav0/cam0/sensor.yaml", cam);
   const std::string msg = errorOf();
-  EXPECT_TRUE(contains(msg, "cam0/sensor.yaml")) << msg;
-  EXPECT_TRUE(contains(msg, "key 'intrinsics'")) << msg;
-  EXPECT_TRUE(contains(msg, "missing")) << msg;
+  EXPECT_TRUE(hasText(msg, "cam0/sensor.yaml")) << msg;
+  EXPECT_TRUE(hasText(msg, "key 'intrinsics'")) << msg;
+  EXPECT_TRUE(hasText(msg, "missing")) << msg;
 }
 
 TEST_F(EurocFixture, RejectsTbsWithFifteenNumbers) {
@@ -215,29 +215,29 @@ TEST_F(EurocFixture, RejectsTbsWithFifteenNumbers) {
   cam.replace(cam.find("0.0, 0.0, 0.0, 1.0]"), 19, "0.0, 0.0, 1.0]");
   write("mav0/cam0/sensor.yaml", cam);
   const std::string msg = errorOf();
-  EXPECT_TRUE(contains(msg, "T_BS.data")) << msg;
-  EXPECT_TRUE(contains(msg, "expected 16 numbers, found 15")) << msg;
+  EXPECT_TRUE(hasText(msg, "T_BS.data")) << msg;
+  EXPECT_TRUE(hasText(msg, "expected 16 numbers, found 15")) << msg;
 }
 
 TEST_F(EurocFixture, RejectsTbsWhoseRotationIsNotARotation) {
   std::string cam = kCamYaml;
   cam.replace(cam.find("[0.0, -1.0"), 10, "[0.0, -2.0");
   write("mav0/cam0/sensor.yaml", cam);
-  EXPECT_TRUE(contains(errorOf(), "not orthonormal"));
+  EXPECT_TRUE(hasText(errorOf(), "not orthonormal"));
 }
 
 TEST_F(EurocFixture, RejectsAnUnknownDistortionModel) {
   std::string cam = kCamYaml;
   cam.replace(cam.find("radial-tangential"), 17, "fisheye62");
   write("mav0/cam0/sensor.yaml", cam);
-  EXPECT_TRUE(contains(errorOf(), "unknown distortion model 'fisheye62'"));
+  EXPECT_TRUE(hasText(errorOf(), "unknown distortion model 'fisheye62'"));
 }
 
 TEST_F(EurocFixture, RejectsAnImuLineWithSixColumns) {
   write("mav0/imu0/data.csv", "#header\n1000,0.1,0.2,0.3,1.0,2.0,9.81\n2000,0.1,0.2,0.3,1.0,2.0\n");
   const std::string msg = errorOf();
-  EXPECT_TRUE(contains(msg, "imu0/data.csv (line 3)")) << msg;
-  EXPECT_TRUE(contains(msg, "expected 7 columns, found 6")) << msg;
+  EXPECT_TRUE(hasText(msg, "imu0/data.csv (line 3)")) << msg;
+  EXPECT_TRUE(hasText(msg, "expected 7 columns, found 6")) << msg;
 }
 
 TEST_F(EurocFixture, RejectsAZeroOrNonFiniteFocalLengthNamingTheKey) {
@@ -245,18 +245,18 @@ TEST_F(EurocFixture, RejectsAZeroOrNonFiniteFocalLengthNamingTheKey) {
   cam.replace(cam.find("intrinsics: [100.0"), 18, "intrinsics: [0.0");
   write("mav0/cam0/sensor.yaml", cam);
   std::string msg = errorOf();
-  EXPECT_TRUE(contains(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
-  EXPECT_TRUE(contains(msg, "focal lengths must be > 0 px, got fx 0, fy 101")) << msg;
+  EXPECT_TRUE(hasText(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
+  EXPECT_TRUE(hasText(msg, "focal lengths must be > 0 px, got fx 0, fy 101")) << msg;
   cam.replace(cam.find("intrinsics: [0.0"), 16, "intrinsics: [.nan");
   write("mav0/cam0/sensor.yaml", cam);
   msg = errorOf();
-  EXPECT_TRUE(contains(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
+  EXPECT_TRUE(hasText(msg, "cam0/sensor.yaml (line 13, key 'intrinsics')")) << msg;
 }
 
 TEST_F(EurocFixture, ImuNoiseFiguresTheSensorYamlLeavesOutAreEmpty) {
   write("mav0/imu0/sensor.yaml", std::string(kImuYaml) + "gyroscope_noise_density: 1.5e-4\n");
   const EurocImuNoise noise = readEurocImuNoise(seq());
-  EXPECT_TRUE(contains(noise.file, "mav0/imu0/sensor.yaml")) << noise.file;
+  EXPECT_TRUE(hasText(noise.file, "mav0/imu0/sensor.yaml")) << noise.file;
   EXPECT_EQ(noise.gyroscope_noise_density, 1.5e-4);
   EXPECT_FALSE(noise.gyroscope_random_walk.has_value());
   EXPECT_FALSE(noise.accelerometer_noise_density.has_value());
@@ -275,8 +275,8 @@ TEST_F(EurocFixture, RejectsANegativeOrNonNumericImuNoiseFigureNamingTheKey) {
 TEST_F(EurocFixture, RejectsNanInAnImuLine) {
   write("mav0/imu0/data.csv", "1000,0.1,nan,0.3,1.0,2.0,9.81\n");
   const std::string msg = errorOf();
-  EXPECT_TRUE(contains(msg, "imu0/data.csv (line 1)")) << msg;
-  EXPECT_TRUE(contains(msg, "nan")) << msg;
+  EXPECT_TRUE(hasText(msg, "imu0/data.csv (line 1)")) << msg;
+  EXPECT_TRUE(hasText(msg, "nan")) << msg;
 }
 
 TEST_F(EurocFixture, DropsImuRowsWhoseStampGoesBackwardsWithACountedWarning) {
@@ -289,7 +289,7 @@ TEST_F(EurocFixture, DropsImuRowsWhoseStampGoesBackwardsWithACountedWarning) {
   EXPECT_EQ(t, (std::vector<Time>{2000, 3000}));
   ASSERT_EQ(reader->drops().measurements, 1u);
   const std::string& msg = reader->drops().notices.at(0);
-  EXPECT_TRUE(contains(msg, "imu0/data.csv (line 2): dropped: timestamp goes back")) << msg;
+  EXPECT_TRUE(hasText(msg, "imu0/data.csv (line 2): dropped: timestamp goes back")) << msg;
 }
 
 TEST_F(EurocFixture, DropsAnImageWhoseStampRepeatsWithACountedWarning) {
@@ -302,7 +302,7 @@ TEST_F(EurocFixture, DropsAnImageWhoseStampRepeatsWithACountedWarning) {
   EXPECT_EQ(t, (std::vector<Time>{2000}));
   ASSERT_EQ(reader->drops().measurements, 1u);
   const std::string& msg = reader->drops().notices.at(0);
-  EXPECT_TRUE(contains(msg, "cam0/data.csv (line 3): dropped: timestamp 0.000002000 s repeats")) << msg;
+  EXPECT_TRUE(hasText(msg, "cam0/data.csv (line 3): dropped: timestamp 0.000002000 s repeats")) << msg;
 }
 
 TEST_F(EurocFixture, RejectsAListedImageThatIsMissingWhenItIsRead) {
@@ -313,22 +313,22 @@ TEST_F(EurocFixture, RejectsAListedImageThatIsMissingWhenItIsRead) {
     reader->next();
     FAIL() << "expected an IoError";
   } catch (const IoError& e) {
-    EXPECT_TRUE(contains(e.what(), "4000.pgm")) << e.what();
-    EXPECT_TRUE(contains(e.what(), "cam0/data.csv line 3")) << e.what();
-    EXPECT_TRUE(contains(e.what(), "not found")) << e.what();
+    EXPECT_TRUE(hasText(e.what(), "4000.pgm")) << e.what();
+    EXPECT_TRUE(hasText(e.what(), "cam0/data.csv line 3")) << e.what();
+    EXPECT_TRUE(hasText(e.what(), "not found")) << e.what();
   }
 }
 
 TEST_F(EurocFixture, RejectsAnImageOfTheWrongSize) {
   write("mav0/cam0/data/2000.pgm", pgm(0, 5, 3));
   const std::string msg = errorOf(/*stream=*/true);
-  EXPECT_TRUE(contains(msg, "2000.pgm")) << msg;
-  EXPECT_TRUE(contains(msg, "5x3")) << msg;
+  EXPECT_TRUE(hasText(msg, "2000.pgm")) << msg;
+  EXPECT_TRUE(hasText(msg, "5x3")) << msg;
 }
 
 TEST_F(EurocFixture, RejectsAnUndecodableImage) {
   write("mav0/cam0/data/2000.pgm", "not an image");
-  EXPECT_TRUE(contains(errorOf(/*stream=*/true), "cannot decode image"));
+  EXPECT_TRUE(hasText(errorOf(/*stream=*/true), "cannot decode image"));
 }
 
 }  // namespace

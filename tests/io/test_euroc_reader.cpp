@@ -20,7 +20,7 @@ struct Stream {
   std::vector<char> kinds;          // 'i' or 'c', in stream order
 };
 
-Stream readAll(Reader& reader) {
+Stream readStream(Reader& reader) {
   Stream s;
   while (auto m = reader.next()) {
     s.times.push_back(measurementTime(*m));
@@ -44,7 +44,7 @@ std::uint64_t pixelSum(const Image& img) {
 TEST(EurocReader, StreamsAllImuSamplesAndFramesOfTheSnippet) {
   DROVER_REQUIRE_SHARED(kSeq);
   auto reader = openEuroc(kSeq.string(), DatasetOptions{});
-  const Stream s = readAll(*reader);
+  const Stream s = readStream(*reader);
   EXPECT_EQ(s.imu.size(), 29120u);  // 200 Hz over 145.6 s
   ASSERT_EQ(s.frames.size(), 95u);  // 20 Hz over 4.7 s
   EXPECT_EQ(reader->describe(), "EuRoC V1_01_easy_micro");
@@ -54,7 +54,7 @@ TEST(EurocReader, FirstAndLastImuSamplesMatchTheCsv) {
   DROVER_REQUIRE_SHARED(kSeq);
   DatasetOptions options;
   options.load_images = false;
-  const Stream s = readAll(*openEuroc(kSeq.string(), options));
+  const Stream s = readStream(*openEuroc(kSeq.string(), options));
   ASSERT_EQ(s.imu.size(), 29120u);
   const ImuSample& first = s.imu.front();
   EXPECT_EQ(first.t, 1403715273262142976);
@@ -77,7 +77,7 @@ TEST(EurocReader, ImagesAreMono8At752x480WithThePixelsOfThePng) {
   DROVER_REQUIRE_SHARED(kSeq);
   DatasetOptions options;
   options.load_imu = false;
-  const Stream s = readAll(*openEuroc(kSeq.string(), options));
+  const Stream s = readStream(*openEuroc(kSeq.string(), options));
   ASSERT_EQ(s.frames.size(), 95u);
   const CameraFrame& first = s.frames.front();
   EXPECT_EQ(first.t, 1403715273262142976);
@@ -98,7 +98,7 @@ TEST(EurocReader, ImagesAreMono8At752x480WithThePixelsOfThePng) {
 
 TEST(EurocReader, MergesInTimeOrderWithImuFirstOnEqualStamps) {
   DROVER_REQUIRE_SHARED(kSeq);
-  const Stream s = readAll(*openEuroc(kSeq.string(), DatasetOptions{}));
+  const Stream s = readStream(*openEuroc(kSeq.string(), DatasetOptions{}));
   ASSERT_EQ(s.times.size(), 29120u + 95u);
   EXPECT_TRUE(std::is_sorted(s.times.begin(), s.times.end()));
   // The first IMU sample and the first image share the stamp 1403715273262142976: IMU comes first.
@@ -155,7 +155,7 @@ TEST(EurocReader, AcceptsTheMav0FolderItself) {
   auto reader = openEuroc((kSeq / "mav0").string(), options);
   EXPECT_EQ(reader->describe(), "EuRoC V1_01_easy_micro");
   EXPECT_EQ(reader->groundTruth().poses.size(), 28712u);  // groundtruth_tum.txt beside mav0/ is still found
-  EXPECT_EQ(readAll(*reader).imu.size(), 29120u);
+  EXPECT_EQ(readStream(*reader).imu.size(), 29120u);
 }
 
 // The ADIS16448's figures as the snippet's imu0/sensor.yaml gives them (read by hand).

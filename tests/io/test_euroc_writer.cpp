@@ -15,14 +15,14 @@ namespace {
 namespace fs = std::filesystem;
 using test::TempDir;
 
-constexpr int kWidth = 10, kHeight = 8;
+constexpr int kEurocWidth = 10, kEurocHeight = 8;
 
-SimDatasetDescription description() {
+SimDatasetDescription eurocDescription() {
   SimDatasetDescription d;
   d.calibration.T_imu_cam.linear() = Eigen::AngleAxisd(1.5, Eigen::Vector3d(1, -2, 3).normalized()).toRotationMatrix();
   d.calibration.T_imu_cam.translation() = Eigen::Vector3d(-0.0216, -0.0647, 0.0098);
   CameraIntrinsics& k = d.calibration.camera;
-  k.width = kWidth, k.height = kHeight, k.fx = 4.58654, k.fy = 4.57296, k.cx = 3.67215, k.cy = 2.48375;
+  k.width = kEurocWidth, k.height = kEurocHeight, k.fx = 4.58654, k.fy = 4.57296, k.cx = 3.67215, k.cy = 2.48375;
   k.distortion = DistortionModel::kRadialTangential;
   k.distortion_coeffs = {-0.28340811, 0.07395907, 0.00019359, 1.76187114e-05};
   d.sensors.camera_rate_hz = 20;
@@ -31,7 +31,7 @@ SimDatasetDescription description() {
   return d;
 }
 
-ImuSample imuAt(Time t) {
+ImuSample eurocImuAt(Time t) {
   ImuSample s;
   s.t = t;
   s.omega_imu = Eigen::Vector3d(-0.002 + 1e-12 * static_cast<double>(t), 1.0 / 3.0, 0.078);
@@ -39,11 +39,11 @@ ImuSample imuAt(Time t) {
   return s;
 }
 
-CameraFrame frameAt(Time t) {
+CameraFrame eurocFrameAt(Time t) {
   CameraFrame f;
   f.t = t;
-  f.image.width = kWidth, f.image.height = kHeight, f.image.channels = 1;
-  for (int i = 0; i < kWidth * kHeight; ++i) f.image.data.push_back(static_cast<std::uint8_t>(i * 3 + t % 11));
+  f.image.width = kEurocWidth, f.image.height = kEurocHeight, f.image.channels = 1;
+  for (int i = 0; i < kEurocWidth * kEurocHeight; ++i) f.image.data.push_back(static_cast<std::uint8_t>(i * 3 + t % 11));
   return f;
 }
 
@@ -59,40 +59,40 @@ EurocTruthState truthAt(Time t) {
 }
 
 // IMU every 5 ns from 1000, frames every 50 ns from 1003, the truth on the IMU's stamps.
-void writeDataset(const fs::path& dir) {
-  EurocDatasetWriter w(dir.string(), description(), false);
+void writeEurocDataset(const fs::path& dir) {
+  EurocDatasetWriter w(dir.string(), eurocDescription(), false);
   std::vector<EurocTruthState> truth;
   for (Time t = 1000; t <= 1200; t += 5) {
-    w.add(imuAt(t));
+    w.add(eurocImuAt(t));
     truth.push_back(truthAt(t));
-    if ((t - 1000) % 50 == 0 && t + 3 <= 1200) w.add(frameAt(t + 3));
+    if ((t - 1000) % 50 == 0 && t + 3 <= 1200) w.add(eurocFrameAt(t + 3));
   }
   w.finish(truth);
 }
 
 TEST(EurocWriter, WhatItWritesTheEurocReaderReadsBackExactly) {
   TempDir tmp;
-  writeDataset(tmp / "seq");
+  writeEurocDataset(tmp / "seq");
   ASSERT_TRUE(fs::is_regular_file(tmp / "seq" / "mav0" / "cam0" / "data" / "1003.png"));
   auto reader = openEuroc((tmp / "seq").string(), DatasetOptions{});
   const Calibration& c = reader->calibration();
-  EXPECT_TRUE(c.T_imu_cam.isApprox(description().calibration.T_imu_cam, 1e-15));
-  EXPECT_EQ(c.camera.width, kWidth);
-  EXPECT_EQ(c.camera.height, kHeight);
+  EXPECT_TRUE(c.T_imu_cam.isApprox(eurocDescription().calibration.T_imu_cam, 1e-15));
+  EXPECT_EQ(c.camera.width, kEurocWidth);
+  EXPECT_EQ(c.camera.height, kEurocHeight);
   EXPECT_EQ(c.camera.fx, 4.58654);
   EXPECT_EQ(c.camera.cy, 2.48375);
   EXPECT_EQ(c.camera.distortion, DistortionModel::kRadialTangential);
-  EXPECT_EQ(c.camera.distortion_coeffs, description().calibration.camera.distortion_coeffs);
+  EXPECT_EQ(c.camera.distortion_coeffs, eurocDescription().calibration.camera.distortion_coeffs);
   std::size_t imu = 0, frames = 0;
   while (const std::optional<Measurement> m = reader->next()) {
     if (const auto* s = std::get_if<ImuSample>(&*m)) {
-      const ImuSample want = imuAt(1000 + 5 * static_cast<Time>(imu++));
+      const ImuSample want = eurocImuAt(1000 + 5 * static_cast<Time>(imu++));
       EXPECT_EQ(s->t, want.t);
       EXPECT_EQ(s->omega_imu, want.omega_imu);  // doubles written to round-trip exactly
       EXPECT_EQ(s->acc_imu, want.acc_imu);
     } else {
       const auto& f = std::get<CameraFrame>(*m);
-      const CameraFrame want = frameAt(1003 + 50 * static_cast<Time>(frames++));
+      const CameraFrame want = eurocFrameAt(1003 + 50 * static_cast<Time>(frames++));
       EXPECT_EQ(f.t, want.t);
       EXPECT_EQ(f.image.data, want.image.data);  // PNG is lossless
     }
@@ -108,28 +108,28 @@ TEST(EurocWriter, WhatItWritesTheEurocReaderReadsBackExactly) {
 
 TEST(EurocWriter, RefusesLidarScansAndRecordsThatDoNotAdvance) {
   TempDir tmp;
-  EurocDatasetWriter w((tmp / "seq").string(), description(), false);
+  EurocDatasetWriter w((tmp / "seq").string(), eurocDescription(), false);
   LidarScan scan;
   scan.t = 1000;
   EXPECT_THROW(w.add(scan), std::invalid_argument);
-  w.add(imuAt(1000));
-  EXPECT_THROW(w.add(imuAt(1000)), std::invalid_argument);
-  w.add(frameAt(1000));
-  EXPECT_THROW(w.add(frameAt(999)), std::invalid_argument);
-  CameraFrame wrong_size = frameAt(1100);
-  wrong_size.image.width = kWidth - 1;
+  w.add(eurocImuAt(1000));
+  EXPECT_THROW(w.add(eurocImuAt(1000)), std::invalid_argument);
+  w.add(eurocFrameAt(1000));
+  EXPECT_THROW(w.add(eurocFrameAt(999)), std::invalid_argument);
+  CameraFrame wrong_size = eurocFrameAt(1100);
+  wrong_size.image.width = kEurocWidth - 1;
   EXPECT_THROW(w.add(std::move(wrong_size)), std::invalid_argument);
 }
 
 TEST(EurocWriter, AWriterThatDoesNotFinishLeavesNothingAndOnlyItsOwnOutputIsReplaced) {
   TempDir tmp;
   {
-    EurocDatasetWriter w((tmp / "seq").string(), description(), false);
-    w.add(imuAt(1000));
+    EurocDatasetWriter w((tmp / "seq").string(), eurocDescription(), false);
+    w.add(eurocImuAt(1000));
   }
   EXPECT_FALSE(fs::exists(tmp / "seq"));
   EXPECT_FALSE(fs::exists(tmp / "seq.partial"));
-  writeDataset(tmp / "seq");
+  writeEurocDataset(tmp / "seq");
   EXPECT_THROW(EurocDatasetWriter::checkOutput((tmp / "seq").string(), false), IoError);  // needs --force
   EXPECT_NO_THROW(EurocDatasetWriter::checkOutput((tmp / "seq").string(), true));
   test::writeText(tmp / "notes" / "todo.txt", "mine\n");

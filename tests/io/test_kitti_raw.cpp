@@ -21,7 +21,7 @@ using test::writeText;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kEr = 6378137.0;
-constexpr Time kT0 = 1317386421LL * kNanosPerSecond;  // 2011-09-30 12:40:21 read as UTC (timegm)
+constexpr Time kRawT0 = 1317386421LL * kNanosPerSecond;  // 2011-09-30 12:40:21 read as UTC (timegm)
 
 using test::expectIoError;
 
@@ -158,7 +158,7 @@ TEST_P(KittiRawLayouts, GroundTruthReproducesTheAnalyticCircleToAMillimetre) {
   double worst = 0;
   for (int k = 0; k < kOxts; ++k) {
     const double t = 0.01 * k;
-    EXPECT_EQ(gt.poses[k].t, kT0 + 10'000'000LL * k);
+    EXPECT_EQ(gt.poses[k].t, kRawT0 + 10'000'000LL * k);
     const Eigen::Vector3d expected = R0.transpose() * (Motion::position(t) - Motion::position(0));
     worst = std::max(worst, (gt.poses[k].T_world_body.translation() - expected).norm());
     EXPECT_LT((gt.poses[k].T_world_body.linear() - R0.transpose() * Motion::rotation(t)).norm(), 1e-9);
@@ -173,7 +173,7 @@ TEST_P(KittiRawLayouts, ImuSamplesUseForwardLeftUpFields) {
   KittiRawReader reader(writeDrive(dir, GetParam()).string(), DatasetOptions{});
   ASSERT_EQ(reader.imuSamples().size(), static_cast<std::size_t>(kOxts));
   const ImuSample& s = reader.imuSamples()[7];
-  EXPECT_EQ(s.t, kT0 + 70'000'000);
+  EXPECT_EQ(s.t, kRawT0 + 70'000'000);
   EXPECT_EQ(s.omega_imu, Eigen::Vector3d(0.001, -0.002, 0.2));  // wf wl wu, not wx wy wz = 11 12 13
   EXPECT_EQ(s.acc_imu, Eigen::Vector3d(0.1, 2.0, 9.81));         // af al au, not ax ay az = 21 22 23
   ASSERT_TRUE(s.q_world_imu.has_value());
@@ -192,8 +192,8 @@ TEST_P(KittiRawLayouts, MergesStreamsInTimeOrderImuBeforeLidarBeforeCamera) {
       EXPECT_LE(measurementTime(all[i - 1]), measurementTime(all[i]));
     }
     if (const auto* scan = std::get_if<LidarScan>(&all[i])) {
-      EXPECT_EQ(scan->t, kT0 + kScanStart[scans]);
-      EXPECT_EQ(scan->t_end, kT0 + kScanStart[scans] + 98'000'000);
+      EXPECT_EQ(scan->t, kRawT0 + kScanStart[scans]);
+      EXPECT_EQ(scan->t_end, kRawT0 + kScanStart[scans] + 98'000'000);
       EXPECT_FALSE(scan->has_time);
       ASSERT_EQ(scan->points.size(), 2u);
       EXPECT_EQ(scan->points[0].x, 1.5f * scans);
@@ -206,7 +206,7 @@ TEST_P(KittiRawLayouts, MergesStreamsInTimeOrderImuBeforeLidarBeforeCamera) {
       }
       ++scans;
     } else if (const auto* cam = std::get_if<CameraFrame>(&all[i])) {
-      EXPECT_EQ(cam->t, kT0 + kImage[images]);
+      EXPECT_EQ(cam->t, kRawT0 + kImage[images]);
       EXPECT_EQ(cam->camera_id, 2);
       EXPECT_EQ(cam->image.data, (std::vector<std::uint8_t>{3, 2, 1}));  // RGB file -> BGR
       ++images;
@@ -256,9 +256,9 @@ INSTANTIATE_TEST_SUITE_P(Layouts, KittiRawLayouts, ::testing::Bool(),
                          [](const auto& info) { return info.param ? "sync" : "extract"; });
 
 TEST(KittiRawReader, ParsesTimestampsExactlyToTheNanosecond) {
-  EXPECT_EQ(parseKittiTimestamp("2011-09-30 12:40:21.123456789", "f", ""), kT0 + 123'456'789);
-  EXPECT_EQ(parseKittiTimestamp("2011-09-30 12:40:21.5", "f", ""), kT0 + 500'000'000);
-  EXPECT_EQ(parseKittiTimestamp("2011-09-30 12:40:21", "f", ""), kT0);
+  EXPECT_EQ(parseKittiTimestamp("2011-09-30 12:40:21.123456789", "f", ""), kRawT0 + 123'456'789);
+  EXPECT_EQ(parseKittiTimestamp("2011-09-30 12:40:21.5", "f", ""), kRawT0 + 500'000'000);
+  EXPECT_EQ(parseKittiTimestamp("2011-09-30 12:40:21", "f", ""), kRawT0);
   EXPECT_EQ(parseKittiTimestamp("1970-01-01 00:00:00.000000001", "f", ""), 1);
   EXPECT_EQ(parseKittiTimestamp("2012-03-01 00:00:00", "f", ""), 1330560000LL * kNanosPerSecond);  // after Feb 29
   for (const char* bad : {"2011-13-30 12:40:21.1", "2011-09-30T12:40:21.1", "2011-09-30 12:40:21.", "garbage",
@@ -314,7 +314,7 @@ TEST(KittiRawReader, DropsAScanWhoseStampGoesBackwardsWithACountedWarning) {
   KittiRawReader reader(drive.string(), options);
   std::vector<Time> scans;
   while (auto m = reader.next()) scans.push_back(std::get<LidarScan>(*m).t);
-  EXPECT_EQ(scans, (std::vector<Time>{kT0 + kScanStart[0], kT0 + kScanStart[2]}));
+  EXPECT_EQ(scans, (std::vector<Time>{kRawT0 + kScanStart[0], kRawT0 + kScanStart[2]}));
   ASSERT_EQ(reader.drops().measurements, 1u);
   const std::string& notice = reader.drops().notices.at(0);
   EXPECT_NE(notice.find("timestamps_start.txt (frame 1): dropped: timestamp goes back"), std::string::npos) << notice;

@@ -30,7 +30,7 @@ struct Streams {
   std::vector<CameraFrame> frames;
 };
 
-Streams readAll(Reader& reader) {
+Streams readStreams(Reader& reader) {
   Streams s;
   while (auto m = reader.next()) {
     if (auto* x = std::get_if<ImuSample>(&*m)) s.imu.push_back(*x);
@@ -62,8 +62,8 @@ class SimBag : public ::testing::Test {
     calibration_ = simulator.calibration();
     const std::unique_ptr<Reader> sim_reader = openSimDataset((*dir_ / "course").string(), DatasetOptions{});
     BagReader bag_reader((*dir_ / "course.bag").string(), loadDatasetOptions(config("farm_sim_bag.yaml")));
-    folder_ = readAll(*sim_reader);
-    bag_ = readAll(bag_reader);
+    folder_ = readStreams(*sim_reader);
+    bag_ = readStreams(bag_reader);
     folder_gt_ = sim_reader->groundTruth();
     bag_gt_ = bag_reader.groundTruth();
     bag_warnings_ = bag_reader.warnings();

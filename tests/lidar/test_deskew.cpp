@@ -11,12 +11,13 @@
 #include "geometry/se3.hpp"
 #include "lidar/deskew.hpp"
 #include "sim/lidar_model.hpp"
+#include "support/units.hpp"
 
 namespace drover::lidar {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using ::drover::test::kSec;
+using ::drover::test::kDeg;
 
 sim::SplineTrajectory trajectoryOf(const std::function<sim::PathSample(double)>& f) {
   std::vector<sim::PathSample> samples;

@@ -18,17 +18,18 @@
 #include "lidar/scan_layout.hpp"
 #include "sim/lidar_model.hpp"
 #include "support/shared_data.hpp"
+#include "support/units.hpp"
 
 namespace drover::lidar {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
+using ::drover::test::kSec;
 const Eigen::Vector2d kHalf(12, 8);              // room half extents in x, y [m]; walls only (floor, ceiling at +-6)
 const Eigen::Vector3d kSensor(2.0, 1.0, 0.0);   // lidar position in the room; axes aligned with the world
 const Eigen::Vector3d kPoleBase(7.0, 1.5, -6);  // a pole 5 m in front of the lidar, in front of the wall x = 12
 constexpr double kPoleRadius = 0.3;
 
-sim::World room(bool with_pole) {
+sim::World extractorRoom(bool with_pole) {
   sim::World w;
   sim::Box box;
   box.half_extents = Eigen::Vector3d(kHalf.x(), kHalf.y(), 6);
@@ -46,7 +47,7 @@ LidarScan simulatedScan(bool with_pole) {
   }
   sim::LidarModelConfig c = sim::LidarModelConfig::forModel("vlp16");
   c.noise = false;
-  return sim::simulateSweep(room(with_pole), sim::SplineTrajectory(samples), Eigen::Isometry3d::Identity(),
+  return sim::simulateSweep(extractorRoom(with_pole), sim::SplineTrajectory(samples), Eigen::Isometry3d::Identity(),
                             kSec / 10, c, 1, 0);
 }
 

@@ -11,12 +11,13 @@
 #include "lidar/scan_layout.hpp"
 #include "sim/lidar_model.hpp"
 #include "support/shared_data.hpp"
+#include "support/units.hpp"
 
 namespace drover::lidar {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using ::drover::test::kSec;
+using ::drover::test::kDeg;
 
 sim::SplineTrajectory standingStill(const Eigen::Vector3d& p, double yaw) {
   std::vector<sim::PathSample> samples;
@@ -31,7 +32,7 @@ sim::SplineTrajectory standingStill(const Eigen::Vector3d& p, double yaw) {
 }
 
 // A closed 20 x 14 x 10 m room: every beam hits something.
-sim::World room() {
+sim::World layoutRoom() {
   sim::World w;
   sim::Box box;
   box.half_extents = Eigen::Vector3d(10, 7, 5);
@@ -44,7 +45,7 @@ LidarScan simulatedVlp16(bool clockwise = false) {
   sim::LidarModelConfig c = sim::LidarModelConfig::forModel("vlp16");
   c.noise = false;
   c.spin_clockwise = clockwise;
-  return sim::simulateSweep(room(), standingStill({1.0, -2.0, 0.3}, 0.4), Eigen::Isometry3d::Identity(), kSec / 5,
+  return sim::simulateSweep(layoutRoom(), standingStill({1.0, -2.0, 0.3}, 0.4), Eigen::Isometry3d::Identity(), kSec / 5,
                             c, 1, 0);
 }
 

@@ -15,11 +15,12 @@
 #include "geometry/so3.hpp"
 #include "lidar/scan_matcher.hpp"
 #include "lidar/scan_matcher_residual.hpp"
+#include "support/units.hpp"
 
 namespace drover::lidar {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
+using ::drover::test::kDeg;
 
 // The rectangle origin + a u + b v, a in [0, lu], b in [0, lv] (u, v orthonormal).
 struct Rect {
@@ -117,7 +118,7 @@ FeatureSet sampleScan(const Scene& scene, const Eigen::Isometry3d& T_world_lidar
   return scan;
 }
 
-Eigen::Isometry3d pose(const Eigen::Vector3d& t, double roll, double pitch, double yaw) {
+Eigen::Isometry3d poseRpy(const Eigen::Vector3d& t, double roll, double pitch, double yaw) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
                 Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
@@ -141,7 +142,7 @@ double rotationErrorDeg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) 
 }
 
 const Scene kRoom = boxRoom({-10.0, -6.0, -1.5}, {10.0, 6.0, 3.0});
-const Eigen::Isometry3d kRoomOffset = pose({0.3, 0.2, 0.05}, 1.0 * kDeg, 0.0, 5.0 * kDeg);
+const Eigen::Isometry3d kRoomOffset = poseRpy({0.3, 0.2, 0.05}, 1.0 * kDeg, 0.0, 5.0 * kDeg);
 
 TEST(ScanMatcher, RecoversAKnownOffsetOnABoxRoomToAMillimetre) {
   const LocalMap map = buildMap(sampleMap(kRoom, 0.2));
@@ -176,8 +177,8 @@ TEST(ScanMatcher, HuberKernelRecoversTheSameOffset) {
 TEST(ScanMatcher, ReportsACorridorAsDegenerateAlongItsAxisAndKeepsTheGuessAlongIt) {
   const Scene scene = corridor(100.0, 1.5, -1.2, 2.0);
   const LocalMap map = buildMap(sampleMap(scene, 0.2));
-  const Eigen::Isometry3d truth = pose({0.4, 0.1, 0.05}, 0.5 * kDeg, -0.3 * kDeg, 2.0 * kDeg);
-  const Eigen::Isometry3d guess = pose({-0.2, 0.0, 0.0}, 0.0, 0.0, 0.0);
+  const Eigen::Isometry3d truth = poseRpy({0.4, 0.1, 0.05}, 0.5 * kDeg, -0.3 * kDeg, 2.0 * kDeg);
+  const Eigen::Isometry3d guess = poseRpy({-0.2, 0.0, 0.0}, 0.0, 0.0, 0.0);
   const FeatureSet scan = sampleScan(scene, truth, 1500, 300, 40.0, 3);
   const MatchResult result = ScanMatcher().align(scan, map, guess);
   EXPECT_TRUE(result.converged) << result.reason;
@@ -201,7 +202,7 @@ TEST(ScanMatcher, ReportsACorridorAsDegenerateAlongItsAxisAndKeepsTheGuessAlongI
 TEST(ScanMatcher, TooFewScanFeaturesReturnTheGuessNotConverged) {
   const LocalMap map = buildMap(sampleMap(kRoom, 0.2));
   const FeatureSet scan = sampleScan(kRoom, kRoomOffset, 60, 5, 100.0, 4);
-  const Eigen::Isometry3d guess = pose({0.1, 0.0, 0.0}, 0.0, 0.0, 0.1);
+  const Eigen::Isometry3d guess = poseRpy({0.1, 0.0, 0.0}, 0.0, 0.0, 0.1);
   const MatchResult result = ScanMatcher().align(scan, map, guess);
   EXPECT_FALSE(result.converged);
   EXPECT_EQ(result.status, MatchStatus::kTooFewFeatures);
@@ -212,7 +213,7 @@ TEST(ScanMatcher, TooFewScanFeaturesReturnTheGuessNotConverged) {
 TEST(ScanMatcher, AScanFarFromTheMapFindsTooFewCorrespondencesAndReturnsTheGuess) {
   const LocalMap map = buildMap(sampleMap(kRoom, 0.2));
   const FeatureSet scan = sampleScan(kRoom, kRoomOffset, 1500, 300, 100.0, 5);
-  const Eigen::Isometry3d guess = pose({500.0, 0.0, 0.0}, 0.0, 0.0, 0.0);
+  const Eigen::Isometry3d guess = poseRpy({500.0, 0.0, 0.0}, 0.0, 0.0, 0.0);
   const MatchResult result = ScanMatcher().align(scan, map, guess);
   EXPECT_FALSE(result.converged);
   EXPECT_EQ(result.status, MatchStatus::kTooFewCorrespondences) << result.reason;
@@ -313,7 +314,7 @@ TEST(ScanMatcherResidual, AnalyticJacobiansMatchNumericalOnes) {
                                              {1.8, 2.4, 3.0}};
   std::vector<Eigen::Vector3d> plane = {{0, 0, 1}, {1, 0, 1.1}, {0, 1, 0.9}, {1, 1, 1.0}, {0.5, 0.5, 1.0}};
   const detail::FeatureFit fits[] = {detail::fitLine(line.data(), 5, 3.0), detail::fitPlane(plane.data(), 5, 0.2)};
-  const Eigen::Isometry3d T = pose({0.5, -1.0, 2.0}, 0.3, -0.2, 1.1);
+  const Eigen::Isometry3d T = poseRpy({0.5, -1.0, 2.0}, 0.3, -0.2, 1.1);
   const Eigen::Vector3d p(2.0, -1.0, 0.7);
   for (const auto& fit : fits) {
     ASSERT_TRUE(fit.valid);

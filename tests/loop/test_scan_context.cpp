@@ -10,11 +10,12 @@
 #include "io/trajectory_io.hpp"
 #include "loop/scan_context.hpp"
 #include "support/shared_data.hpp"
+#include "support/units.hpp"
 
 namespace drover::loop {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kPi;
 
 // Poles and walls of different heights around the origin, sampled densely, none on a sector boundary by design
 // (azimuths are offset by a third of a sector).

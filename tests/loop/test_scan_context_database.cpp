@@ -27,7 +27,7 @@ lidar::PointCloud place(int seed) {
 }
 
 // The same place seen by a sensor turned by psi about z (p_B = Rz(-psi) p_A).
-lidar::PointCloud turned(const lidar::PointCloud& a, double psi) {
+lidar::PointCloud turnedCloud(const lidar::PointCloud& a, double psi) {
   const Eigen::Matrix3f R = Eigen::AngleAxisf(float(-psi), Eigen::Vector3f::UnitZ()).toRotationMatrix();
   lidar::PointCloud b;
   for (const auto& p : a) b.push_back(R * p);
@@ -47,7 +47,7 @@ TEST(ScanContextDatabase, FindsTheRevisitedPlaceAmongTwoHundredWithItsShift) {
   EXPECT_EQ(db.searchable(), 200u);
   for (int id : {3, 77, 150}) {
     const double psi = (id % 13) * kSector;
-    const AugmentedScanContext q = makeAugmentedScanContext(turned(place(id), psi), db.config().descriptor);
+    const AugmentedScanContext q = makeAugmentedScanContext(turnedCloud(place(id), psi), db.config().descriptor);
     const DatabaseQuery r = db.query(q);
     ASSERT_FALSE(r.candidates.empty());
     EXPECT_EQ(r.candidates[0].id, id);
@@ -79,7 +79,7 @@ TEST(ScanContextDatabase, AYawPriorNarrowsEachCandidatesSearchToSevenShifts) {
   ScanContextDatabase db(config(0));
   for (int id = 0; id < 20; ++id) db.add(id, makeScanContext(place(id), db.config().descriptor));
   const double psi = 9 * kSector;
-  const AugmentedScanContext q = makeAugmentedScanContext(turned(place(4), psi), db.config().descriptor);
+  const AugmentedScanContext q = makeAugmentedScanContext(turnedCloud(place(4), psi), db.config().descriptor);
   const DatabaseQuery full = db.query(q);
   const DatabaseQuery narrowed = db.query(q, [&](int) { return std::optional<double>(psi + 0.5 * kSector); });
   ASSERT_FALSE(narrowed.candidates.empty());
@@ -97,7 +97,7 @@ TEST(ScanContextDatabase, APriorWithoutFallBackReachScoresOtherPlacesByTheirWind
   ScanContextDatabase db(config(0));
   for (int id = 0; id < 20; ++id) db.add(id, makeScanContext(place(id), db.config().descriptor));
   const double psi = 9 * kSector;
-  const AugmentedScanContext q = makeAugmentedScanContext(turned(place(4), psi), db.config().descriptor);
+  const AugmentedScanContext q = makeAugmentedScanContext(turnedCloud(place(4), psi), db.config().descriptor);
   const DatabaseQuery r = db.query(q, [&](int) { return std::optional<YawPrior>(YawPrior(psi + 0.5 * kSector, 3)); });
   ASSERT_EQ(r.candidates.size(), 10u);
   EXPECT_EQ(r.candidates[0].id, 4);  // the revisit is still found, in its window

@@ -12,11 +12,12 @@
 #include "geometry/so3.hpp"
 #include "pipeline/loop_closure.hpp"
 #include "support/courtyard.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kPi;
 
 LoopClosureConfig courtyardConfig() {
   LoopClosureConfig c;

@@ -13,11 +13,12 @@
 #include "pipeline/loop_closure.hpp"
 #include "sim/scenario.hpp"
 #include "sim/simulator.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kPi;
 
 // The simulated overlap course: 88 s, 82 m, a loop driven and then partly driven again.
 struct OverlapRun {
@@ -66,7 +67,7 @@ const OverlapRun& overlap() {
   return run;
 }
 
-Eigen::Isometry3d truthAt(const Trajectory& truth, Time t) {
+Eigen::Isometry3d truthPoseAt(const Trajectory& truth, Time t) {
   for (const StampedPose& p : truth)
     if (std::abs(p.t - t) < 3'000'000) return p.T_world_body;
   ADD_FAILURE() << "no ground truth at " << t;
@@ -81,7 +82,7 @@ TEST(LoopClosureSim, EveryAcceptedLoopOnTheOverlapCourseIsTrueAndTheTrajectorySt
   for (const LoopEvent& e : r.events) {
     if (!e.verification.accepted) continue;
     const Eigen::Isometry3d T_true =
-        truthAt(r.lidar_truth, e.t_candidate).inverse() * truthAt(r.lidar_truth, e.t_query);
+        truthPoseAt(r.lidar_truth, e.t_candidate).inverse() * truthPoseAt(r.lidar_truth, e.t_query);
     const Eigen::Isometry3d err = T_true.inverse() * e.verification.T_candidate_query;
     EXPECT_LT(err.translation().norm(), 0.3) << "loop " << e.query << " -> " << e.candidate;
     EXPECT_LT(Eigen::AngleAxisd(err.linear()).angle() * 180 / kPi, 1.0);

@@ -10,11 +10,12 @@
 #include "pipeline/loop_closure.hpp"
 #include "pipeline/loop_drift_path.hpp"
 #include "support/courtyard.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kPi;
 
 std::vector<DriftStep> unitSteps(std::size_t n) {
   std::vector<DriftStep> steps(n, DriftStep{1.0, 1.0});
@@ -47,7 +48,7 @@ TEST(CheapestDriftPath, AnAcceptedLoopIsAFreeShortcutAndTheCostsOfTheStepsAreSum
 }
 
 // Keyframe i on a circle of radius 4 m around the courtyard's centre, 10 deg apart, heading along it; 36 a lap.
-Eigen::Isometry3d lapPose(int i) {
+Eigen::Isometry3d driftLapPose(int i) {
   const double theta = i * 10.0 * kPi / 180.0;
   return test::planarPose(4 * std::cos(theta), 4 * std::sin(theta), i * 10.0 + 90.0);
 }
@@ -68,10 +69,10 @@ std::unique_ptr<LoopClosure> twoLapsPastTurnedKeyframes(bool through_loops) {
   auto loops = std::make_unique<LoopClosure>(c);
   lidar::LocalMap map;
   for (int i = 0; i <= 60; ++i) {
-    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
+    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), driftLapPose(i));
     f.t = fromSeconds(i);
     const bool turned = i >= 12 && i <= 15;
-    const Eigen::Isometry3d T_est = turned ? lapPose(i) * test::planarPose(0, 0, 30.0) : lapPose(i);
+    const Eigen::Isometry3d T_est = turned ? driftLapPose(i) * test::planarPose(0, 0, 30.0) : driftLapPose(i);
     if (loops->addKeyframe(map, map.addKeyframe(f, T_est), geometry::Matrix6d::Zero())) {
       const std::vector<Eigen::Isometry3d> poses = loops->poses();
       for (std::size_t k = 0; k < poses.size(); ++k) map.updatePose(k, poses[k]);

@@ -10,19 +10,20 @@
 
 #include "pipeline/loop_closure.hpp"
 #include "support/courtyard.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kPi;
 
 // Keyframe i of a lap of radius 4 m around the courtyard's centre, 10 deg apart, heading along the circle.
-Eigen::Isometry3d lapPose(int i) {
+Eigen::Isometry3d fallbackLapPose(int i) {
   const double theta = i * 10.0 * kPi / 180.0;
   return test::planarPose(4 * std::cos(theta), 4 * std::sin(theta), i * 10.0 + 90.0);
 }
 
-LoopClosureConfig courtyardConfig(ShiftFallback fallback) {
+LoopClosureConfig fallbackCourtyardConfig(ShiftFallback fallback) {
   LoopClosureConfig c;
   c.min_age = 15.0;  // keyframes are 1 s apart below
   c.database.exclude_recent = 10;
@@ -41,11 +42,11 @@ LoopClosureConfig courtyardConfig(ShiftFallback fallback) {
 std::unique_ptr<LoopClosure> driftingLap(const LoopClosureConfig& config, int& closed) {
   auto loops = std::make_unique<LoopClosure>(config);
   lidar::LocalMap map;
-  Eigen::Isometry3d T_est = lapPose(0);
+  Eigen::Isometry3d T_est = fallbackLapPose(0);
   closed = 0;
   for (int i = 0; i <= 40; ++i) {
-    if (i > 0) T_est = T_est * lapPose(i - 1).inverse() * lapPose(i) * test::planarPose(0, 0, 0.8);
-    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), lapPose(i));
+    if (i > 0) T_est = T_est * fallbackLapPose(i - 1).inverse() * fallbackLapPose(i) * test::planarPose(0, 0, 0.8);
+    lidar::FeatureSet f = test::seenFrom(test::courtyard(0), fallbackLapPose(i));
     f.t = fromSeconds(i);
     if (loops->addKeyframe(map, map.addKeyframe(f, T_est), geometry::Matrix6d::Zero())) {
       ++closed;
@@ -78,8 +79,8 @@ TEST(ShiftFallbackRadius, FollowsTheRotationBudgetInSectorsRoundedUpPlusOne) {
 
 TEST(LoopShiftFallback, ARevisitWhoseEstimatedYawDriftedBeyondTheWindowIsClosedForFewerShiftsThanTheFullSearch) {
   int closed_always = 0, closed_budget = 0;
-  const auto always = driftingLap(courtyardConfig(ShiftFallback::kAlways), closed_always);
-  const auto budget = driftingLap(courtyardConfig(ShiftFallback::kBudget), closed_budget);
+  const auto always = driftingLap(fallbackCourtyardConfig(ShiftFallback::kAlways), closed_always);
+  const auto budget = driftingLap(fallbackCourtyardConfig(ShiftFallback::kBudget), closed_budget);
   ASSERT_GE(closed_always, 1);
   ASSERT_GE(closed_budget, 1);
   for (const LoopEvent& e : budget->events()) {
@@ -91,7 +92,7 @@ TEST(LoopShiftFallback, ARevisitWhoseEstimatedYawDriftedBeyondTheWindowIsClosedF
     if (!e.verification.accepted) continue;
     // The lap's end back at its start (36 keyframes a lap), within the synthetic verifier's half metre.
     EXPECT_NEAR(double(e.query - e.candidate), 36.0, 2.0);
-    const Eigen::Isometry3d T_true = lapPose(int(e.candidate)).inverse() * lapPose(int(e.query));
+    const Eigen::Isometry3d T_true = fallbackLapPose(int(e.candidate)).inverse() * fallbackLapPose(int(e.query));
     EXPECT_LT((T_true.inverse() * e.verification.T_candidate_query).translation().norm(), 0.5);
   }
   // Every keyframe of the lap sees the same courtyard, so the full search also offers candidates turned far from
@@ -103,7 +104,7 @@ TEST(LoopShiftFallback, ARevisitWhoseEstimatedYawDriftedBeyondTheWindowIsClosedF
 TEST(LoopShiftFallback, TheCountersGiveEachPolicysShiftEvaluations) {
   for (const ShiftFallback f : {ShiftFallback::kAlways, ShiftFallback::kBudget, ShiftFallback::kNever}) {
     int closed = 0;
-    const LoopStats s = driftingLap(courtyardConfig(f), closed)->stats();
+    const LoopStats s = driftingLap(fallbackCourtyardConfig(f), closed)->stats();
     SCOPED_TRACE(toString(f));
     EXPECT_GT(s.narrowed_searches + s.fallbacks, 0u);
     // The window is 7 shifts; a fall-back adds every shift again (always) or the 2 x (7 - 3) beyond the window
@@ -120,7 +121,7 @@ TEST(LoopShiftFallback, TheCountersGiveEachPolicysShiftEvaluations) {
 }
 
 TEST(LoopShiftFallback, WithABudgetInsideTheWindowNoCandidateFallsBack) {
-  LoopClosureConfig c = courtyardConfig(ShiftFallback::kBudget);
+  LoopClosureConfig c = fallbackCourtyardConfig(ShiftFallback::kBudget);
   // 0.1 rad + at most 0.015 rad over the lap = 1.1 sectors -> 2 + 1 = 3, the window's own reach.
   c.max_rotation_drift_floor = 0.1;
   int closed = 0;

@@ -26,14 +26,14 @@ const test::LiveCourse& movingCourse() {
   return c;
 }
 
-OdometryConfig simConfig(int moving_start_restart) {
+OdometryConfig movingStartConfig(int moving_start_restart) {
   OdometryConfig c = test::simOdometryConfig();
   c.moving_start_restart = moving_start_restart;
   return c;
 }
 
 // The truth's velocity at t [m/s] (central difference of its 200 Hz positions).
-Eigen::Vector3d truthVelocity(Time t) {
+Eigen::Vector3d movingTruthVelocity(Time t) {
   const Trajectory& truth = movingCourse().truth;
   const auto it = test::truthFrom(truth, t);
   const std::size_t i = std::clamp<std::size_t>(static_cast<std::size_t>(it - truth.begin()), 1, truth.size() - 2);
@@ -49,14 +49,14 @@ struct StartRun {
 };
 
 // The truth's pose at t (nearest 200 Hz sample).
-const Eigen::Isometry3d& truthAt(Time t) {
+const Eigen::Isometry3d& movingTruthAt(Time t) {
   const Trajectory& truth = movingCourse().truth;
   const auto it = test::truthFrom(truth, t);
   return (it == truth.end() ? truth.back() : *it).T_world_body;
 }
 
 StartRun runFromMovingStart(int moving_start_restart) {
-  LidarOdometry odometry(simConfig(moving_start_restart), movingCourse().calibration);
+  LidarOdometry odometry(movingStartConfig(moving_start_restart), movingCourse().calibration);
   std::vector<ScanOutcome> outcomes;
   for (const Measurement& m : movingCourse().stream)
     for (ScanOutcome& o : odometry.process(m)) outcomes.push_back(std::move(o));
@@ -69,11 +69,11 @@ StartRun runFromMovingStart(int moving_start_restart) {
   int n = 0;
   for (const ScanOutcome& o : outcomes) {
     if (!o.has_imu_state || o.t < fromSeconds(kStart + 1.0)) continue;
-    sum_sq += (o.v_world - truthVelocity(o.t)).squaredNorm();
+    sum_sq += (o.v_world - movingTruthVelocity(o.t)).squaredNorm();
     ++n;
     r.max_acc_bias_error = std::max(r.max_acc_bias_error, (o.acc_bias - true_acc_bias).norm());
     // Up in the IMU frame, estimated and true: the tilt the accelerometer bias trades with.
-    const Eigen::Matrix3d R_est = (o.T_world_lidar * T_lidar_imu).linear(), R_true = truthAt(o.t).linear();
+    const Eigen::Matrix3d R_est = (o.T_world_lidar * T_lidar_imu).linear(), R_true = movingTruthAt(o.t).linear();
     const Eigen::Vector3d up_est = R_est.transpose().col(2), up_true = R_true.transpose().col(2);
     r.max_tilt_error = std::max(r.max_tilt_error, std::acos(std::clamp(up_est.dot(up_true), -1.0, 1.0)));
   }
@@ -86,7 +86,7 @@ StartRun runFromMovingStart(int moving_start_restart) {
 }
 
 TEST(MovingStart, AtTheSpeedTheLidarMeasuresTheSmootherRestartsAndKeepsVelocityAndTiltTrue) {
-  ASSERT_GT(truthVelocity(fromSeconds(kStart)).norm(), 1.0) << "the course must be moving at the first sweep";
+  ASSERT_GT(movingTruthVelocity(fromSeconds(kStart)).norm(), 1.0) << "the course must be moving at the first sweep";
   const StartRun restarted = runFromMovingStart(OdometryConfig{}.moving_start_restart);
   // At a constant 1.2 m/s the IMU window looks static: the lidar is what says the start was moving.
   EXPECT_NE(restarted.imu_init.find("by the lidar: the smoother restarted"), std::string::npos) << restarted.imu_init;
@@ -103,7 +103,7 @@ TEST(MovingStart, AtTheSpeedTheLidarMeasuresTheSmootherRestartsAndKeepsVelocityA
 
 TEST(MovingStart, AStartAtRestIsNotRestarted) {
   const test::LiveCourse at_rest = test::sharpTurnsCourse(2.0);  // at rest for its first 2.5 s
-  LidarOdometry odometry(simConfig(OdometryConfig{}.moving_start_restart), at_rest.calibration);
+  LidarOdometry odometry(movingStartConfig(OdometryConfig{}.moving_start_restart), at_rest.calibration);
   for (const Measurement& m : at_rest.stream) odometry.process(m);
   odometry.finish();
   const std::string& note = odometry.stats().imu_init;

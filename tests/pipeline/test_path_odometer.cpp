@@ -3,11 +3,12 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/path_odometer.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
+using ::drover::test::kSec;
 
 TEST(PathOdometer, GivesThePathLengthBetweenTwoTimesLinearBetweenTheStates) {
   PathOdometer o;

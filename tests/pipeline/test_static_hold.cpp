@@ -1,6 +1,7 @@
 // pipeline::StaticHold: a static start held at rest until the IMU's integrated specific force or rate (less the
 // rest's) says the platform moved.
 #include "pipeline/static_hold.hpp"
+#include "support/units.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +10,7 @@
 namespace drover::pipeline {
 namespace {
 
-constexpr Time kMs = 1'000'000;
+using ::drover::test::kMs;
 const Eigen::Vector3d kRestForce(0.02, -0.01, 9.81);  // [m/s^2] gravity and an accelerometer bias, IMU frame
 const Eigen::Vector3d kRestRate(0.002, -0.001, 0.0015);  // [rad/s] the gyro bias
 

@@ -34,11 +34,11 @@ const Course& sharpTurns() {
   return c;
 }
 
-OdometryConfig simConfig() { return test::simOdometryConfig(); }
+OdometryConfig systemSimConfig() { return test::simOdometryConfig(); }
 
 SystemConfig liveConfig(int sweep_queue) {
   SystemConfig c;
-  c.odometry = simConfig();
+  c.odometry = systemSimConfig();
   c.live.sweep_queue = sweep_queue;
   return c;
 }
@@ -54,7 +54,7 @@ Trajectory replay(const Course& course, const OdometryConfig& config) {
 
 TEST(System, FedWithoutDropsItGivesTheReplaysTrajectoryAndFlushesEverySweepAtShutdown) {
   const Course& course = sharpTurns();
-  const Trajectory expected = replay(course, simConfig());
+  const Trajectory expected = replay(course, systemSimConfig());
   std::atomic<std::size_t> sweeps{0};
   SystemCallbacks cb;
   cb.sweep = [&](const ScanOutcome&) { ++sweeps; };
@@ -164,7 +164,7 @@ TEST(System, StateAccessorsRefuseBeforeShutdownAndPushesAfterItAreIgnored) {
 // candidates equal.)
 TEST(SystemLoops, TheLoopThreadAcceptsTheReplaysLoopsOnTheOverlapCourse) {
   const Course course = simulate("overlap", 70.0, 3);
-  OdometryConfig config = simConfig();
+  OdometryConfig config = systemSimConfig();
   config.local_map.retire_age = 8.0;  // [s] so that the start, driven again at ~60 s, retires keyframes here
   LidarOdometry replayed(config, course.calibration);
   for (const Measurement& m : course.stream) replayed.process(m);

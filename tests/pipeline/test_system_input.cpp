@@ -17,7 +17,7 @@ namespace drover::pipeline {
 namespace {
 
 // 16 s of the sharp-turns course (at rest 2.5 s, 11 m straight, then turning), VLP-16 at 10 Hz and IMU at 200 Hz.
-const test::LiveCourse& course() {
+const test::LiveCourse& inputCourse() {
   static const test::LiveCourse c = test::simulateLiveCourse("sharp-turns", 16.0, 7);
   return c;
 }
@@ -58,7 +58,7 @@ struct Listener {
   }
 };
 
-SystemConfig config(int sweep_queue) {
+SystemConfig inputConfig(int sweep_queue) {
   SystemConfig c;
   c.odometry = test::simOdometryConfig();
   c.live.sweep_queue = sweep_queue;
@@ -74,7 +74,7 @@ std::size_t sweepsIn(const std::vector<Measurement>& stream) {
 // Every 20th sweep from the 20th on comes after the sweep that follows it (7 pairs swapped): the late one is
 // skipped as the LIS skips a backwards stamp, with its notice as a live warning, and the rest track the truth.
 TEST(SystemInput, SweepsOutOfOrderAreSkippedWithAWarningAndTheOthersTrackTheTruth) {
-  std::vector<Measurement> stream = course().stream;
+  std::vector<Measurement> stream = inputCourse().stream;
   std::vector<std::size_t> sweeps;
   for (std::size_t i = 0; i < stream.size(); ++i)
     if (std::holds_alternative<LidarScan>(stream[i])) sweeps.push_back(i);
@@ -82,14 +82,14 @@ TEST(SystemInput, SweepsOutOfOrderAreSkippedWithAWarningAndTheOthersTrackTheTrut
   for (std::size_t k = 20; k + 1 < sweeps.size(); k += 20, ++swapped) std::swap(stream[sweeps[k]], stream[sweeps[k + 1]]);
   ASSERT_EQ(swapped, 7u);
   Listener l;
-  System system(config(1'000'000), course().calibration, l.callbacks());
+  System system(inputConfig(1'000'000), inputCourse().calibration, l.callbacks());
   for (const Measurement& m : stream) test::pushMeasurement(system, m);
   system.shutdown();
   EXPECT_EQ(system.lis().stats().scans_skipped_time, swapped);
   EXPECT_EQ(l.count("is not after the previous sweep's"), swapped);
   EXPECT_EQ(l.sweeps.load(), sweeps.size() - swapped);
   EXPECT_EQ(system.stats().clock_jumps, 0u);  // 0.1 s back is out of order, not a clock jump
-  const double worst = test::worstSweepError(system.lis().trajectory(), course());
+  const double worst = test::worstSweepError(system.lis().trajectory(), inputCourse());
   std::printf("7 sweeps out of order: worst sweep position error %.3f m\n", worst);
   EXPECT_LT(worst, 0.10);  // [m] as without the swaps
 }
@@ -99,14 +99,14 @@ TEST(SystemInput, SweepsOutOfOrderAreSkippedWithAWarningAndTheOthersTrackTheTrut
 // and carries on.
 TEST(SystemInput, ASensorThatStopsAndRestartsIsReportedAndTheLisTracksOn) {
   std::vector<Measurement> stream;
-  for (const Measurement& m : course().stream) {
+  for (const Measurement& m : inputCourse().stream) {
     const double t = toSeconds(stampOf(m));
     if (std::holds_alternative<LidarScan>(m) && t > 6.0 && t < 9.0) continue;
     if (std::holds_alternative<ImuSample>(m) && t > 11.0 && t < 11.6) continue;
     stream.push_back(m);
   }
   Listener l;
-  System system(config(1'000'000), course().calibration, l.callbacks());
+  System system(inputConfig(1'000'000), inputCourse().calibration, l.callbacks());
   test::feedAsInRealTime(system, stream, l.sweeps);
   system.shutdown();
   EXPECT_EQ(system.stats().sensor_restarts, 1u);
@@ -115,7 +115,7 @@ TEST(SystemInput, ASensorThatStopsAndRestartsIsReportedAndTheLisTracksOn) {
   EXPECT_EQ(system.lis().stats().imu.gaps, 1u);
   EXPECT_EQ(l.sweeps.load(), sweepsIn(stream));
   EXPECT_EQ(system.stats().sweeps_dropped, 0u);
-  const double worst = test::worstSweepError(system.lis().trajectory(), course());
+  const double worst = test::worstSweepError(system.lis().trajectory(), inputCourse());
   std::printf("lidar silent 3 s, IMU silent 0.6 s: worst sweep position error %.3f m\n", worst);
   EXPECT_LT(worst, 0.15);  // [m]
 }
@@ -126,7 +126,7 @@ TEST(SystemInput, ASensorThatStopsAndRestartsIsReportedAndTheLisTracksOn) {
 TEST(SystemInput, AClockThatJumpsBackStopsTheInputWithOneReportAndShutsDownCleanly) {
   std::vector<Measurement> before, after;
   const Time jump_at = fromSeconds(8.0), back = fromSeconds(5.0);
-  for (Measurement m : course().stream) {
+  for (Measurement m : inputCourse().stream) {
     if (stampOf(m) < jump_at) {
       before.push_back(std::move(m));
       continue;
@@ -139,7 +139,7 @@ TEST(SystemInput, AClockThatJumpsBackStopsTheInputWithOneReportAndShutsDownClean
     after.push_back(std::move(m));
   }
   Listener l;
-  System system(config(1'000'000), course().calibration, l.callbacks());
+  System system(inputConfig(1'000'000), inputCourse().calibration, l.callbacks());
   test::feedAsInRealTime(system, before, l.sweeps);
   for (const Measurement& m : after) test::pushMeasurement(system, m);  // all ignored: no pacing needed
   system.shutdown();
@@ -155,7 +155,7 @@ TEST(SystemInput, AClockThatJumpsBackStopsTheInputWithOneReportAndShutsDownClean
   ASSERT_FALSE(t.empty());
   EXPECT_LT(t.back().t, jump_at);
   EXPECT_GE(t.back().t, jump_at - fromSeconds(0.3));
-  EXPECT_LT(test::worstSweepError(t, course()), 0.10);
+  EXPECT_LT(test::worstSweepError(t, inputCourse()), 0.10);
 }
 
 // After 5 s, 3 s of data (30 sweeps, 600 IMU samples) arrive at once, as from a stalled network link, with the
@@ -164,12 +164,12 @@ TEST(SystemInput, AClockThatJumpsBackStopsTheInputWithOneReportAndShutsDownClean
 TEST(SystemInput, ABurstOfMessagesDropsTheOldestWaitingSweepsAndTheLisRecovers) {
   const Time burst_from = fromSeconds(5.0), burst_to = fromSeconds(8.0);
   std::vector<Measurement> head, burst, tail;
-  for (const Measurement& m : course().stream) {
+  for (const Measurement& m : inputCourse().stream) {
     const Time t = stampOf(m);
     (t < burst_from ? head : t < burst_to ? burst : tail).push_back(m);
   }
   Listener l;
-  System system(config(2), course().calibration, l.callbacks());
+  System system(inputConfig(2), inputCourse().calibration, l.callbacks());
   test::feedAsInRealTime(system, head, l.sweeps);
   for (const Measurement& m : burst) test::pushMeasurement(system, m);
   test::feedAsInRealTime(system, tail, l.sweeps);
@@ -184,20 +184,20 @@ TEST(SystemInput, ABurstOfMessagesDropsTheOldestWaitingSweepsAndTheLisRecovers) 
   EXPECT_EQ(system.lis().stats().imu.accepted, s.imu_pushed);
   EXPECT_EQ(system.lis().stats().imu.dropped_out_of_order, 0u);
   // ~3 m driven on the IMU across the dropped sweeps, then matched again: within a few cm of the truth at the end.
-  const double worst = test::worstSweepError(system.lis().trajectory(), course(), burst_to);
+  const double worst = test::worstSweepError(system.lis().trajectory(), inputCourse(), burst_to);
   std::printf("burst: %zu of %zu sweeps dropped; worst sweep position error after it %.3f m\n", s.sweeps_dropped,
               burst_sweeps, worst);
   EXPECT_LT(worst, 0.15);
 }
 
 TEST(SystemInput, RejectsANonPositiveClockJumpOrSensorGapNamingTheKey) {
-  SystemConfig c = config(2);
+  SystemConfig c = inputConfig(2);
   c.live.clock_jump_s = 0;
   EXPECT_EQ(c.live.validate(), "live.clock_jump_s must be > 0");
   c.live.clock_jump_s = 1;
   c.live.sensor_gap_s = -1;
   EXPECT_EQ(c.live.validate(), "live.sensor_gap_s must be > 0");
-  EXPECT_THROW(System(c, course().calibration, {}), std::invalid_argument);
+  EXPECT_THROW(System(c, inputCourse().calibration, {}), std::invalid_argument);
 }
 
 }  // namespace

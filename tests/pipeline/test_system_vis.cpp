@@ -18,7 +18,7 @@ namespace drover::pipeline {
 namespace {
 
 // 14 s of the sharp-turns course with its 15 Hz camera: at rest 2.5 s, 11 m straight, then turning.
-const test::LiveCourse& course() {
+const test::LiveCourse& visCourse() {
   static const test::LiveCourse c = test::simulateLiveCourse("sharp-turns", 14.0, 5, true);
   return c;
 }
@@ -51,11 +51,11 @@ TEST(SystemVis, TheVisRunsInItsOwnThreadStartsFromTheLisAndTracksTheTruth) {
     std::lock_guard<std::mutex> lock(mutex);
     frames.push_back(f);
   };
-  System system(config(), course().calibration, cb, shiTomasi());
+  System system(config(), visCourse().calibration, cb, shiTomasi());
   // Paced as a live stream whose LIS keeps up: a frame goes in once the sweeps before it are fused (the VIS reads
   // the LIS's newest IMU-rate poses, which exist only then).
   std::size_t pushed_sweeps = 0;
-  for (const Measurement& m : course().stream) {
+  for (const Measurement& m : visCourse().stream) {
     if (const auto* imu = std::get_if<ImuSample>(&m)) {
       system.pushImu(*imu);
     } else if (const auto* scan = std::get_if<LidarScan>(&m)) {
@@ -77,9 +77,9 @@ TEST(SystemVis, TheVisRunsInItsOwnThreadStartsFromTheLisAndTracksTheTruth) {
   double worst = 0;
   // The VIS is seeded in the LIS's world: compare with the truth through the LIS's first pose.
   const Trajectory& lis = system.lis().trajectory();
-  const Eigen::Isometry3d T_lidar_imu = course().calibration.T_imu_lidar.inverse();
+  const Eigen::Isometry3d T_lidar_imu = visCourse().calibration.T_imu_lidar.inverse();
   const auto truthAt = [](Time t) -> const Eigen::Isometry3d* {
-    const Trajectory& truth = course().truth;
+    const Trajectory& truth = visCourse().truth;
     const auto it = std::lower_bound(truth.begin(), truth.end(), t,
                                      [](const StampedPose& p, Time x) { return p.t < x; });
     return it != truth.end() && std::abs(it->t - t) < 3'000'000 ? &it->T_world_body : nullptr;

@@ -7,11 +7,12 @@
 #include <string>
 
 #include "pipeline/visual_motion.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
+using ::drover::test::kSec;
 
 // Two sweeps 0.1 s apart ending at t_b, driving straight along x at lis_speed, and a VIS saying vis_speed, its last
 // keyframe keyframe_age before t_b.

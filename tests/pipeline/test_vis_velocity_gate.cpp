@@ -12,13 +12,14 @@
 #include "pipeline/lidar_odometry.hpp"
 #include "sim/imu_model.hpp"
 #include "sim/trajectory.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
+using ::drover::test::kSec;
 constexpr Time kSweep = kSec / 10;       // 10 Hz lidar
-constexpr Time kFrame = kSec / 15;       // 15 Hz camera
+constexpr Time kGateFrame = kSec / 15;       // 15 Hz camera
 constexpr Time kBlindFrom = 5 * kSec;    // the VIS slows to 70 % here; the degenerate stretch starts here
 
 // At rest for 1 s, 0.5 m/s^2 to 1 m/s by 3 s, then 1 m/s along x (knots every 0.5 s).
@@ -37,7 +38,7 @@ sim::SplineTrajectory walk() {
 // The VIS's state at t: the truth until kBlindFrom, then 70 % of the truth's motion and velocity.
 VisualState slowVis(const sim::SplineTrajectory& path, Time t) {
   const sim::BodyState b = path.at(t);
-  VisualState s{t, b.T_world_body, b.v_world, imu::ImuBias{}, 120, 1, 0, t, kFrame, std::nullopt};
+  VisualState s{t, b.T_world_body, b.v_world, imu::ImuBias{}, 120, 1, 0, t, kGateFrame, std::nullopt};
   if (t > kBlindFrom) {
     const Eigen::Vector3d p0 = path.at(kBlindFrom).T_world_body.translation();
     s.T_world_imu.translation() = p0 + 0.7 * (b.T_world_body.translation() - p0);
@@ -59,7 +60,7 @@ std::vector<ScanOutcome> run(Time until, bool blind) {
   Time next_frame = 0;
   const auto feedUntil = [&](Time t) {
     for (; next_imu < imu.size() && imu[next_imu].t <= t; ++next_imu) fusion.addImu(imu[next_imu]);
-    for (; next_frame <= t; next_frame += kFrame) fusion.addVisualState(slowVis(path, next_frame));
+    for (; next_frame <= t; next_frame += kGateFrame) fusion.addVisualState(slowVis(path, next_frame));
   };
   feedUntil(fromSeconds(config.initializer.window_s) + kSweep);
   fusion.tryInitialize(0, true);

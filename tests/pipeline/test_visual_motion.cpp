@@ -11,11 +11,12 @@
 #include "pipeline/visual_motion.hpp"
 #include "sim/imu_model.hpp"
 #include "sim/trajectory.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
+using ::drover::test::kSec;
 constexpr Time kFrame = kSec / 15;  // 15 Hz camera
 
 // 8 s turning, climbing and accelerating (knots every 0.5 s).
@@ -34,11 +35,11 @@ sim::SplineTrajectory turningPath() {
   return sim::SplineTrajectory(samples);
 }
 
-struct Course {
+struct MotionCourse {
   sim::SplineTrajectory path = turningPath();
   std::vector<ImuSample> imu;
   imu::PreintegrationConfig preintegration;
-  Course() {
+  MotionCourse() {
     sim::ImuModelConfig m;  // noiseless and unbiased: the propagation is then exact up to discretisation
     m.gyro_noise_density = m.accel_noise_density = 0;
     m.gyro_bias_random_walk = m.accel_bias_random_walk = 0;
@@ -60,14 +61,14 @@ struct Course {
   }
 };
 
-const Course& course() {
-  static const Course c;
+const MotionCourse& motionCourse() {
+  static const MotionCourse c;
   return c;
 }
 
 VisualMotion motionWithFrames(Time until, const VisualMotionConfig& config = {}) {
-  VisualMotion m(config, course().preintegration);
-  for (Time t = 0; t <= until; t += kFrame) m.add(course().state(t));
+  VisualMotion m(config, motionCourse().preintegration);
+  for (Time t = 0; t <= until; t += kFrame) m.add(motionCourse().state(t));
   return m;
 }
 
@@ -106,9 +107,9 @@ TEST(VisualMotion, TheIncrementBetweenTwoSweepStampsIsTheTrueMotionCarriedFromTh
   const Time a = 5 * kSec + 30'000'000, b = a + kSec / 10;
   const VisualMotion m = motionWithFrames(b + 20'000'000);
   std::string why;
-  const std::optional<VisualIncrement> inc = m.increment(a, b, course().propagator(b + 20'000'000), &why);
+  const std::optional<VisualIncrement> inc = m.increment(a, b, motionCourse().propagator(b + 20'000'000), &why);
   ASSERT_TRUE(inc) << why;
-  const Eigen::Isometry3d truth = course().path.at(a).T_world_body.inverse() * course().path.at(b).T_world_body;
+  const Eigen::Isometry3d truth = motionCourse().path.at(a).T_world_body.inverse() * motionCourse().path.at(b).T_world_body;
   const double dp = (inc->T_a_b.translation() - truth.translation()).norm();
   const double dr = geometry::logSO3(truth.linear().transpose() * inc->T_a_b.linear()).norm();
   std::printf("increment over %.3f m: |dp| %.2e m, |dtheta| %.2e rad\n", truth.translation().norm(), dp, dr);
@@ -126,18 +127,18 @@ TEST(VisualMotion, TheIncrementBetweenTwoSweepStampsIsTheTrueMotionCarriedFromTh
 TEST(VisualMotion, WithTheWindowCovarianceTheSigmaIsTheFramesCovariancesSummedPlusTheFloor) {
   VisualMotionConfig c;
   c.window_covariance = true;
-  VisualMotion m(c, course().preintegration);
+  VisualMotion m(c, motionCourse().preintegration);
   // Each frame's motion from the one before: 3 mm and 1 mrad per axis (the VIS's window, vio::FrameResult).
   Eigen::Matrix<double, 6, 6> step = Eigen::Matrix<double, 6, 6>::Zero();
   step.diagonal() << Eigen::Vector3d::Constant(9e-6), Eigen::Vector3d::Constant(1e-6);
   for (Time t = 0; t <= 6 * kSec; t += kFrame) {
-    VisualState s = course().state(t);
+    VisualState s = motionCourse().state(t);
     if (t > 0) s.relative_covariance = step;
     m.add(s);
   }
   const Time a = 5 * kSec + 30'000'000, b = a + kSec / 10;  // states at 5.000 and 5.067 s (frames 75, 76): one step
   std::string why;
-  const std::optional<VisualIncrement> inc = m.increment(a, b, course().propagator(6 * kSec), &why);
+  const std::optional<VisualIncrement> inc = m.increment(a, b, motionCourse().propagator(6 * kSec), &why);
   ASSERT_TRUE(inc) << why;
   const Eigen::Matrix<double, 6, 6> cov = (inc->sqrt_information.transpose() * inc->sqrt_information).inverse();
   // Rotated into a's frame per step; the traces do not depend on that rotation.
@@ -145,13 +146,13 @@ TEST(VisualMotion, WithTheWindowCovarianceTheSigmaIsTheFramesCovariancesSummedPl
   EXPECT_NEAR(position_trace, 3 * (9e-6 + c.window_floor_position * c.window_floor_position), 1e-9);
   EXPECT_NEAR(rotation_trace, 3 * (1e-6 + c.window_floor_rotation * c.window_floor_rotation), 1e-10);
   // A frame without a covariance between: the drift model instead.
-  VisualMotion gap(c, course().preintegration);
+  VisualMotion gap(c, motionCourse().preintegration);
   for (Time t = 0; t <= 6 * kSec; t += kFrame) {
-    VisualState s = course().state(t);
+    VisualState s = motionCourse().state(t);
     if (t > 0 && t != 76 * kFrame) s.relative_covariance = step;  // the frame at 5.067 s has none
     gap.add(s);
   }
-  const std::optional<VisualIncrement> drift = gap.increment(a, b, course().propagator(6 * kSec), &why);
+  const std::optional<VisualIncrement> drift = gap.increment(a, b, motionCourse().propagator(6 * kSec), &why);
   ASSERT_TRUE(drift) << why;
   EXPECT_NEAR(1 / drift->sqrt_information(5, 5), c.sigma_rotation + c.sigma_rotation_ratio *
               geometry::logSO3(drift->T_a_b.linear()).norm(), 1e-6);
@@ -159,12 +160,12 @@ TEST(VisualMotion, WithTheWindowCovarianceTheSigmaIsTheFramesCovariancesSummedPl
 
 TEST(VisualMotion, FewerFeaturesThanAFullFrameWidenTheSigmasAsOneOverTheSquareRoot) {
   const VisualMotionConfig c;  // full_features 80
-  VisualMotion full(c, course().preintegration), quarter(c, course().preintegration);
+  VisualMotion full(c, motionCourse().preintegration), quarter(c, motionCourse().preintegration);
   for (Time t = 0; t <= 3 * kSec; t += kFrame) {
-    full.add(course().state(t, 80));
-    quarter.add(course().state(t, 20));
+    full.add(motionCourse().state(t, 80));
+    quarter.add(motionCourse().state(t, 20));
   }
-  const imu::ImuPropagator imu = course().propagator(3 * kSec);
+  const imu::ImuPropagator imu = motionCourse().propagator(3 * kSec);
   const auto a = full.increment(2 * kSec, 2 * kSec + kSec / 10, imu, nullptr);
   const auto b = quarter.increment(2 * kSec, 2 * kSec + kSec / 10, imu, nullptr);
   ASSERT_TRUE(a && b);
@@ -173,36 +174,36 @@ TEST(VisualMotion, FewerFeaturesThanAFullFrameWidenTheSigmasAsOneOverTheSquareRo
 }
 
 TEST(VisualMotion, AnUnhealthyVisGivesNoMotionAndSaysWhy) {
-  const imu::ImuPropagator imu = course().propagator(4 * kSec);
+  const imu::ImuPropagator imu = motionCourse().propagator(4 * kSec);
   const Time a = 3 * kSec, b = a + kSec / 10;
   std::string why;
   {  // nothing before the first stamp
-    VisualMotion m({}, course().preintegration);
-    m.add(course().state(b + kFrame));
+    VisualMotion m({}, motionCourse().preintegration);
+    m.add(motionCourse().state(b + kFrame));
     EXPECT_FALSE(m.increment(a, b, imu, &why));
     EXPECT_NE(why.find("no VIS state"), std::string::npos) << why;
   }
   {  // a camera blackout: the newest state is 0.5 s old
-    VisualMotion m({}, course().preintegration);
-    for (Time t = 0; t <= a - kSec / 2; t += kFrame) m.add(course().state(t));
+    VisualMotion m({}, motionCourse().preintegration);
+    for (Time t = 0; t <= a - kSec / 2; t += kFrame) m.add(motionCourse().state(t));
     EXPECT_FALSE(m.increment(a, b, imu, &why));
     EXPECT_NE(why.find("old"), std::string::npos) << why;
   }
   {  // too few features in the solve
-    VisualMotion m({}, course().preintegration);
-    for (Time t = 0; t <= b; t += kFrame) m.add(course().state(t, 12));
+    VisualMotion m({}, motionCourse().preintegration);
+    for (Time t = 0; t <= b; t += kFrame) m.add(motionCourse().state(t, 12));
     EXPECT_FALSE(m.increment(a, b, imu, &why));
     EXPECT_NE(why.find("12 features"), std::string::npos) << why;
   }
   {  // initialised 0.5 s before: still warming up
-    VisualMotion m({}, course().preintegration);
-    for (Time t = 0; t <= b; t += kFrame) m.add(course().state(t, 120, 1, a - kSec / 2));
+    VisualMotion m({}, motionCourse().preintegration);
+    for (Time t = 0; t <= b; t += kFrame) m.add(motionCourse().state(t, 120, 1, a - kSec / 2));
     EXPECT_FALSE(m.increment(a, b, imu, &why));
     EXPECT_NE(why.find("warmup"), std::string::npos) << why;
   }
   {  // a reset between the two stamps (LVI-SAM's reset ID): the two poses are of different windows
-    VisualMotion m({}, course().preintegration);
-    for (Time t = 0; t <= b; t += kFrame) m.add(course().state(t, 120, t < a + kSec / 20 ? 1 : 2, 0));
+    VisualMotion m({}, motionCourse().preintegration);
+    for (Time t = 0; t <= b; t += kFrame) m.add(motionCourse().state(t, 120, t < a + kSec / 20 ? 1 : 2, 0));
     EXPECT_FALSE(m.increment(a, b, imu, &why));
     EXPECT_NE(why.find("reset"), std::string::npos) << why;
   }
@@ -277,10 +278,10 @@ TEST(VisualMotion, TheIncrementCarriesTheVisGravityAndAccelerometerBiasAtTheLate
   const Time a = 5 * kSec + 30'000'000, b = a + kSec / 10;
   const VisualMotion m = motionWithFrames(b + 20'000'000);
   std::string why;
-  const std::optional<VisualIncrement> inc = m.increment(a, b, course().propagator(b + 20'000'000), &why);
+  const std::optional<VisualIncrement> inc = m.increment(a, b, motionCourse().propagator(b + 20'000'000), &why);
   ASSERT_TRUE(inc) << why;
-  const Eigen::Matrix3d R_b = course().path.at(b).T_world_body.linear();
-  const Eigen::Vector3d g_b = R_b.transpose() * Eigen::Vector3d(0, 0, -course().preintegration.gravity);
+  const Eigen::Matrix3d R_b = motionCourse().path.at(b).T_world_body.linear();
+  const Eigen::Vector3d g_b = R_b.transpose() * Eigen::Vector3d(0, 0, -motionCourse().preintegration.gravity);
   EXPECT_LT((inc->gravity_b - g_b).norm(), 1e-4) << "pitch and roll vary along the path";
   EXPECT_EQ(inc->acc_bias_b, Eigen::Vector3d::Zero());
 }

@@ -6,11 +6,12 @@
 #include <numbers>
 
 #include "pipeline/visual_yaw_history.hpp"
+#include "support/units.hpp"
 
 namespace drover::pipeline {
 namespace {
 
-constexpr Time kMs = 1'000'000;
+using ::drover::test::kMs;
 
 VisualState stateAt(Time t, double yaw, double pitch, std::uint32_t reset_id) {
   VisualState s;

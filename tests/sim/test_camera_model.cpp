@@ -17,14 +17,14 @@ namespace {
 using drover::test::forwardCamera;
 using drover::test::wallWorld;
 
-constexpr Time kSecond = kNanosPerSecond;
+constexpr Time kCameraSecond = kNanosPerSecond;
 
 // Samples every 0.1 s over [0, 1] s at the origin, yaw = yaw_rate * (t - 0.5 s) (looking along +x at 0.5 s).
 SplineTrajectory yawingTrajectory(double yaw_rate) {
   std::vector<PathSample> samples;
   for (int i = 0; i <= 10; ++i) {
     PathSample s;
-    s.t = i * kSecond / 10;
+    s.t = i * kCameraSecond / 10;
     s.yaw = yaw_rate * (toSeconds(s.t) - 0.5);
     samples.push_back(s);
   }
@@ -231,8 +231,8 @@ TEST(CameraRenderer, WhiteBoxAppearsWhereProjectPredictsAndTheRestIsSky) {
   config.sky = Eigen::Vector3f::Constant(0.2f);
   const CameraRenderer camera(config);
   const World world = whiteBoxAhead();
-  const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kSecond / 2, 1, 0);
-  EXPECT_EQ(frame.t, kSecond / 2);
+  const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kCameraSecond / 2, 1, 0);
+  EXPECT_EQ(frame.t, kCameraSecond / 2);
   EXPECT_EQ(frame.camera_id, 0);
   EXPECT_EQ(frame.source, "sim");
   ASSERT_EQ(frame.image.channels, 1);
@@ -294,7 +294,7 @@ TEST(CameraRenderer, WithFourByFourRaysAPixelOnABoxEdgeReadsTheShareOfItsAreaOnT
   const CameraRenderer camera(config);
   // Front face at x = 4.5 m, y in [-0.9, 0.3]: its left edge (y = 0.3, x_cam = -0.3) at u = cx - fx * 0.3 / 4.5.
   const World world = whiteBoxAhead();
-  const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kSecond / 2, 1, 0);
+  const CameraFrame frame = camera.render(world, stationaryTrajectory(), forwardCamera(), {}, kCameraSecond / 2, 1, 0);
   const double u_edge = config.intrinsics.cx - config.intrinsics.fx * 0.3 / 4.5;
   const double box_grey = 255.0 * lambertFactor(Eigen::Vector3d(-1, 0, 0)), sky_grey = 255.0 * 0.2;
   ASSERT_GT(box_grey, sky_grey + 50);
@@ -318,8 +318,8 @@ TEST(CameraRenderer, TexturedWallHasGradientsWhileAWhiteWallShowsOnlyNoise) {
   const World textured = wallWorld(3.0, noiseMaterial());
   const World white = wallWorld(3.0, whiteMaterial(0.6f));
   const double textured_energy =
-      horizontalGradientEnergy(camera.render(textured, still, forwardCamera(), {}, kSecond / 2, 3, 0).image);
-  const Image white_image = camera.render(white, still, forwardCamera(), {}, kSecond / 2, 3, 0).image;
+      horizontalGradientEnergy(camera.render(textured, still, forwardCamera(), {}, kCameraSecond / 2, 3, 0).image);
+  const Image white_image = camera.render(white, still, forwardCamera(), {}, kCameraSecond / 2, 3, 0).image;
   const double white_energy = horizontalGradientEnergy(white_image);
   // The noise is unbiased with standard deviation sqrt(sigma^2 + 1/12) (read noise + rounding).
   const double mean = meanIntensity(white_image), flat = 255.0 * 0.6 * lambertFactor(Eigen::Vector3d(-1, 0, 0));
@@ -339,8 +339,8 @@ TEST(CameraRenderer, IlluminationScalesIntensityByItsFactor) {
   const SplineTrajectory still = stationaryTrajectory();
   const Illumination daylight = [](Time, const Eigen::Vector3d&) { return 1.0f; };
   const Illumination dusk = [](Time, const Eigen::Vector3d&) { return 0.2f; };
-  const Image bright = camera.render(world, still, forwardCamera(), daylight, kSecond / 2, 1, 0).image;
-  const Image dark = camera.render(world, still, forwardCamera(), dusk, kSecond / 2, 1, 0).image;
+  const Image bright = camera.render(world, still, forwardCamera(), daylight, kCameraSecond / 2, 1, 0).image;
+  const Image dark = camera.render(world, still, forwardCamera(), dusk, kCameraSecond / 2, 1, 0).image;
   const float lambert = lambertFactor(Eigen::Vector3d(-1, 0, 0));
   EXPECT_NEAR(meanIntensity(bright), expectedGrey(0.8f * lambert), 1e-9);  // every pixel, no clipping
   EXPECT_NEAR(meanIntensity(dark), expectedGrey(0.2f * 0.8f * lambert), 1e-9);
@@ -373,7 +373,7 @@ TEST(CameraRenderer, SameSeedGivesIdenticalBytesForAnyThreadCount) {
   const World world = scenarioLikeWorld();
   const SplineTrajectory path = yawingTrajectory(0.5);
   const auto render = [&](std::uint64_t seed, std::uint64_t frame_index) {
-    return camera.render(world, path, forwardCamera(), {}, kSecond / 2, seed, frame_index).image.data;
+    return camera.render(world, path, forwardCamera(), {}, kCameraSecond / 2, seed, frame_index).image.data;
   };
   std::vector<std::uint8_t> one_thread, two_threads;
   {
@@ -402,17 +402,17 @@ TEST(CameraRenderer, MotionBlurOnAFastYawReducesGradientEnergy) {
   CameraModelConfig config = noiselessConfig();
   config.exposure_s = 0.02;
   const double sharp = horizontalGradientEnergy(
-      CameraRenderer(config).render(world, spin, forwardCamera(), {}, kSecond / 2, 1, 0).image);
+      CameraRenderer(config).render(world, spin, forwardCamera(), {}, kCameraSecond / 2, 1, 0).image);
   config.motion_blur_samples = 16;
   const CameraRenderer blurring(config);
   const double blurred =
-      horizontalGradientEnergy(blurring.render(world, spin, forwardCamera(), {}, kSecond / 2, 1, 0).image);
+      horizontalGradientEnergy(blurring.render(world, spin, forwardCamera(), {}, kCameraSecond / 2, 1, 0).image);
   EXPECT_LT(blurred, 0.6 * sharp) << "sharp " << sharp << ", blurred " << blurred;
   // Without motion, averaging sub-frames changes nothing (up to float rounding of the average).
   const SplineTrajectory still = stationaryTrajectory();
-  const Image still_blurred = blurring.render(world, still, forwardCamera(), {}, kSecond / 2, 1, 0).image;
+  const Image still_blurred = blurring.render(world, still, forwardCamera(), {}, kCameraSecond / 2, 1, 0).image;
   const CameraRenderer sharp_camera(noiselessConfig());
-  const Image still_sharp = sharp_camera.render(world, still, forwardCamera(), {}, kSecond / 2, 1, 0).image;
+  const Image still_sharp = sharp_camera.render(world, still, forwardCamera(), {}, kCameraSecond / 2, 1, 0).image;
   int worst = 0;
   for (std::size_t i = 0; i < still_sharp.data.size(); ++i) {
     worst = std::max(worst, std::abs(int{still_sharp.data[i]} - int{still_blurred.data[i]}));

@@ -6,13 +6,14 @@
 
 #include "geometry/so3.hpp"
 #include "sim/imu_model.hpp"
+#include "support/units.hpp"
 
 using namespace drover;
 using namespace drover::sim;
 
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
+using ::drover::test::kSec;
 
 SplineTrajectory splineOf(const std::function<PathSample(double)>& f, Time spacing, int count,
                           std::vector<Vibration> vibrations = {}) {

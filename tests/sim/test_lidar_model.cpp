@@ -10,12 +10,13 @@
 #include <stdexcept>
 
 #include "sim/lidar_model.hpp"
+#include "support/units.hpp"
 
 namespace drover::sim {
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
-constexpr double kDeg = std::numbers::pi / 180.0;
+using ::drover::test::kSec;
+using ::drover::test::kDeg;
 
 // A trajectory sampled every 0.1 s over [0, 2] s from f(t [s]).
 SplineTrajectory trajectoryOf(const std::function<PathSample(double)>& f) {

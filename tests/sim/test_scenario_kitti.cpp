@@ -16,7 +16,7 @@ namespace {
 using Eigen::Vector3d;
 using G = CourseGeometry;
 using probe::nearestObstacle;
-constexpr Time kTenHz = 100'000'000;
+constexpr Time kKittiTenHz = 100'000'000;
 
 bool hasSegment(const Scenario& s, Condition c) {
   return std::any_of(s.segments.begin(), s.segments.end(), [&](const Segment& g) { return g.condition == c; });
@@ -31,7 +31,7 @@ TEST(KittiCameraToZupBody, MapsCameraForwardToBodyXAndLevelsATiltedDrive) {
   for (int i = 0; i < 40; ++i) {
     const double a = 2 * std::numbers::pi * i / 40;
     StampedPose p;
-    p.t = i * kTenHz;
+    p.t = i * kKittiTenHz;
     // In the level camera world (y down): position on a circle in x-z, forward (z) along the tangent.
     const Vector3d pos(20 * (1 - std::cos(a)), 0.0, 20 * std::sin(a));
     const Eigen::Matrix3d R = Eigen::AngleAxisd(a, Vector3d::UnitY()).toRotationMatrix();
@@ -113,7 +113,7 @@ TEST_F(KittiReplay, KeepsEveryTownPrimitiveTwoMetresFromThePath) {
   EXPECT_GT(scenario_->world.primitiveCount(), 500u);
   EXPECT_LT(scenario_->world.primitiveCount(), 5000u);
   const SplineTrajectory& traj = *scenario_->trajectory;
-  for (Time t = traj.startTime(); t <= traj.endTime(); t += 5 * kTenHz)
+  for (Time t = traj.startTime(); t <= traj.endTime(); t += 5 * kKittiTenHz)
     ASSERT_GE(nearestObstacle(*scenario_, t, G::kTownClearance), G::kTownClearance) << "at t = " << toSeconds(t);
   // The road lies the camera height below.
   const Vector3d o = traj.pose(traj.startTime()).translation();

@@ -11,23 +11,23 @@
 namespace drover::sim {
 namespace {
 
-constexpr Time kTenHz = 100'000'000;
+constexpr Time kMavTenHz = 100'000'000;
 
-const Scenario& room() {
+const Scenario& mavRoom() {
   static const Scenario s = makeScenario("mav-room", ScenarioOptions{});
   return s;
 }
 
 TEST(MavRoom, HoversStillAtBothEndsAndFliesInsideTheRoomClearOfEveryWall) {
-  const Scenario& s = room();
+  const Scenario& s = mavRoom();
   const SplineTrajectory& tr = *s.trajectory;
   EXPECT_NEAR(toSeconds(tr.endTime() - tr.startTime()), 100.0, 1e-9);
   EXPECT_LT(tr.at(tr.startTime()).v_world.norm(), 1e-9);
   EXPECT_LT(tr.at(tr.endTime()).v_world.norm(), 1e-9);
-  for (Time t = tr.startTime(); t <= tr.startTime() + 2 * kNanosPerSecond; t += kTenHz / 10)  // the IMU's rest
+  for (Time t = tr.startTime(); t <= tr.startTime() + 2 * kNanosPerSecond; t += kMavTenHz / 10)  // the IMU's rest
     ASSERT_LT(tr.at(t).v_world.norm(), 2e-4) << toSeconds(t);  // the spline's ringing before the motion fades in
   EXPECT_TRUE(s.closes_loop);
-  for (Time t = tr.startTime(); t <= tr.endTime(); t += kTenHz) {
+  for (Time t = tr.startTime(); t <= tr.endTime(); t += kMavTenHz) {
     const Eigen::Vector3d p = tr.pose(t).translation();
     // the room is [-5, 5] x [-4, 4] x [0, 4] m
     EXPECT_LE(std::abs(p.x()), 3.5) << toSeconds(t);
@@ -39,10 +39,10 @@ TEST(MavRoom, HoversStillAtBothEndsAndFliesInsideTheRoomClearOfEveryWall) {
 
 // EuRoC V1_01 flies 0.41 m/s on average at ~0.3 rad/s, V1_02 0.91 m/s at ~0.6 rad/s (Burri et al. 2016).
 TEST(MavRoom, MovesAsEurocsViconRoomSequencesDoBetweenTheEasyAndTheMediumOne) {
-  const SplineTrajectory& tr = *room().trajectory;
+  const SplineTrajectory& tr = *mavRoom().trajectory;
   double speed = 0, rate = 0, max_speed = 0, max_rate = 0, max_acc = 0;
   int n = 0;
-  for (Time t = tr.startTime() + 5 * kNanosPerSecond; t <= tr.endTime() - 5 * kNanosPerSecond; t += kTenHz, ++n) {
+  for (Time t = tr.startTime() + 5 * kNanosPerSecond; t <= tr.endTime() - 5 * kNanosPerSecond; t += kMavTenHz, ++n) {
     const BodyState b = tr.at(t);
     speed += b.v_world.norm(), rate += b.omega_body.norm();
     max_speed = std::max(max_speed, b.v_world.norm());
@@ -62,11 +62,11 @@ TEST(MavRoom, MovesAsEurocsViconRoomSequencesDoBetweenTheEasyAndTheMediumOne) {
 }
 
 TEST(MavRoom, EveryCameraRayHitsTheRoomSoNoFrameLooksIntoTheSky) {
-  const Scenario& s = room();
+  const Scenario& s = mavRoom();
   const SimulatorConfig rig = SimulatorConfig::eurocRig();
   const CameraRenderer camera(rig.camera);
   const Eigen::Isometry3d T_body_cam = Eigen::Isometry3d(rig.R_body_imu) * rig.T_imu_cam;
-  for (Time t = s.trajectory->startTime(); t <= s.trajectory->endTime(); t += 10 * kTenHz) {
+  for (Time t = s.trajectory->startTime(); t <= s.trajectory->endTime(); t += 10 * kMavTenHz) {
     const Eigen::Isometry3d T_world_cam = s.trajectory->pose(t) * T_body_cam;
     for (const auto& [u, v] : {std::pair{0, 0}, {751, 0}, {0, 479}, {751, 479}, {376, 240}}) {
       const Ray ray{T_world_cam.translation(), T_world_cam.linear() * camera.ray(u, v).cast<double>()};

@@ -11,6 +11,7 @@
 #include "sim/sensor_faults.hpp"
 #include "sim/simulator.hpp"
 #include "small_scenario.hpp"
+#include "support/units.hpp"
 
 namespace drover::sim {
 namespace {
@@ -20,7 +21,7 @@ using fixture::sameMeasurement;
 using fixture::smallConfig;
 using fixture::smallScenario;
 
-constexpr Time kMs = 1'000'000;
+using ::drover::test::kMs;
 
 double meanGrey(const CameraFrame& f) {
   const double sum = std::accumulate(f.image.data.begin(), f.image.data.end(), 0.0);

@@ -26,7 +26,7 @@ Material material(Texture t, std::uint32_t seed = 1) {
 float luminance(const Eigen::Vector3f& c) { return 0.299f * c.x() + 0.587f * c.y() + 0.114f * c.z(); }
 
 // Mean |grad luminance| [1/m] by finite differences on a 0.01 m grid over a 2 m x 2 m patch away from the origin.
-double meanGradient(const Material& m) {
+double materialGradient(const Material& m) {
   constexpr double h = 0.01;
   constexpr int n = 200;
   double sum = 0;
@@ -49,13 +49,13 @@ TEST(Texture, WhiteIsExactlyTheAlbedoEverywhere) {
   for (const Eigen::Vector2d& uv : {Eigen::Vector2d(0, 0), Eigen::Vector2d(0.37, -12.5), Eigen::Vector2d(1e3, 4e2)}) {
     EXPECT_EQ(shade(m, uv), m.albedo);
   }
-  EXPECT_EQ(meanGradient(m), 0.0);
+  EXPECT_EQ(materialGradient(m), 0.0);
 }
 
 TEST(Texture, EveryTexturedKindHasStrongGradientsAtCameraScale) {
   // 2 / m of luminance: at 5 m and 460 px focal length (1.1 cm per pixel) that is ~5 grey levels per pixel.
   for (const Texture t : kTextured) {
-    const double g = meanGradient(material(t));
+    const double g = materialGradient(material(t));
     EXPECT_GT(g, 2.0) << "texture " << name(t);
     EXPECT_TRUE(std::isfinite(g)) << "texture " << name(t);
   }

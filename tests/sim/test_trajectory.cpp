@@ -7,14 +7,15 @@
 
 #include "geometry/so3.hpp"
 #include "sim/trajectory.hpp"
+#include "support/units.hpp"
 
 using namespace drover;
 using namespace drover::sim;
 
 namespace {
 
-constexpr Time kSec = 1'000'000'000;
-constexpr double kPi = std::numbers::pi;
+using ::drover::test::kSec;
+using ::drover::test::kPi;
 
 // Uniform samples f(t_rel) at t0 + k * spacing, k = 0..count-1 (t_rel in seconds from t0).
 std::vector<PathSample> samplesOf(const std::function<PathSample(double)>& f, Time spacing, int count, Time t0 = 0) {

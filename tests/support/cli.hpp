@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace drover::test {
 
@@ -51,5 +53,16 @@ inline nlohmann::json readJsonLines(const std::filesystem::path& p) {
 }
 
 inline bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+// A platform file of the repository's config/ folder.
+inline std::string config(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
+
+// The lines of a text, without their line breaks.
+inline std::vector<std::string> linesOf(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) out.push_back(l);
+  return out;
+}
 
 }  // namespace drover::test

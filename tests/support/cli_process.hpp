@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "support/cli.hpp"
+#include "support/temp_dir.hpp"
 
 extern char** environ;
 
@@ -24,13 +25,6 @@ namespace drover::test {
 // runDrover from CWD, with optional `NAME=value ...` environment assignments in front.
 inline CliResult runDroverIn(const std::filesystem::path& cwd, const std::string& args, const std::string& env = "") {
   return runShell("cd '" + cwd.string() + "' && " + env + " " + DROVER_BINARY + " " + args + " 2>&1");
-}
-
-inline std::string readText(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 // drover started in the background with ARGS (split at spaces), its stdout and stderr going to LOG.

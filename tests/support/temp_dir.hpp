@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -31,9 +32,22 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// The whole file as bytes; empty when it cannot be read.
+inline std::string readText(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 inline void writeText(const std::filesystem::path& p, const std::string& text) {
   std::filesystem::create_directories(p.parent_path());
   std::ofstream(p, std::ios::binary) << text;
+}
+
+// Writes `yaml` to dir/platform.yaml; returns its path.
+inline std::string writePlatformFile(const TempDir& dir, const std::string& yaml) {
+  const std::filesystem::path p = dir / "platform.yaml";
+  writeText(p, yaml);
+  return p.string();
 }
 
 }  // namespace drover::test

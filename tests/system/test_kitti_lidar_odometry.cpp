@@ -26,7 +26,7 @@
 namespace drover {
 namespace {
 
-double angleDeg(const Eigen::Isometry3d& T) { return geometry::rotationAngle(T.linear()) * 180.0 / std::numbers::pi; }
+double poseAngleDeg(const Eigen::Isometry3d& T) { return geometry::rotationAngle(T.linear()) * 180.0 / std::numbers::pi; }
 
 void expectWithinBounds(const std::string& sequence, double max_relative_translation, double max_rotation_deg,
                         double max_step_translation, double max_step_rotation_deg) {
@@ -42,12 +42,12 @@ void expectWithinBounds(const std::string& sequence, double max_relative_transla
     travelled += gt.translation().norm();
     // Each step: within 10 cm and 0.3 deg (a wrong step could hide in a good end-to-end figure).
     EXPECT_LT((est.translation() - gt.translation()).norm(), max_step_translation) << sequence << " step " << i;
-    EXPECT_LT(angleDeg(gt.inverse() * est), max_step_rotation_deg) << sequence << " step " << i;
+    EXPECT_LT(poseAngleDeg(gt.inverse() * est), max_step_rotation_deg) << sequence << " step " << i;
   }
   const Eigen::Isometry3d gt = r.truth.front().T_world_body.inverse() * r.truth.back().T_world_body;
   const Eigen::Isometry3d est = r.estimate.front().T_world_body.inverse() * r.estimate.back().T_world_body;
   const double t_err = (est.translation() - gt.translation()).norm();
-  const double r_err = angleDeg(gt.inverse() * est);
+  const double r_err = poseAngleDeg(gt.inverse() * est);
   std::printf("KITTI %s: %.2f m travelled over 9 steps, translation error %.3f m (%.2f %%), rotation %.3f deg\n",
               sequence.c_str(), travelled, t_err, 100.0 * t_err / travelled, r_err);
   ASSERT_GT(travelled, 1.0) << "the snippet must move for the bound to mean anything";

@@ -5,6 +5,7 @@
 #include "geometry/so3.hpp"
 #include "vio/initial_alignment.hpp"
 #include "vio/vio_test_scene.hpp"
+#include "support/units.hpp"
 
 namespace drover::vio {
 namespace {
@@ -14,7 +15,7 @@ using test::Motion;
 using test::Scene;
 using test::SceneConfig;
 
-constexpr double kDeg = M_PI / 180;
+using ::drover::test::kDeg;
 
 // Ground truth expressed like the result: rotated about z so the IMU of frame 0 has yaw 0, origin at frame 0.
 struct Truth {

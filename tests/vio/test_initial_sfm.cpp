@@ -4,6 +4,7 @@
 #include "geometry/so3.hpp"
 #include "vio/initial_sfm.hpp"
 #include "vio/vio_test_scene.hpp"
+#include "support/units.hpp"
 
 namespace drover::vio {
 namespace {
@@ -13,7 +14,7 @@ using test::Motion;
 using test::Scene;
 using test::SceneConfig;
 
-constexpr double kDeg = M_PI / 180;
+using ::drover::test::kDeg;
 
 std::vector<FrameFeatures> featuresOf(const Scene& scene) {
   std::vector<FrameFeatures> out;

@@ -9,14 +9,15 @@
 #include "geometry/so3.hpp"
 #include "vio/scale_check.hpp"
 #include "vio/vio_test_scene.hpp"
+#include "support/units.hpp"
 
 namespace drover::vio {
 namespace {
 
-constexpr double kDeg = M_PI / 180;
+using ::drover::test::kDeg;
 
 // 15 s of keyframes at 4 Hz with exact (hold-equivalent) IMU samples; no features needed.
-test::Scene drive(test::Motion motion) {
+test::Scene scaleDrive(test::Motion motion) {
   test::SceneConfig config;
   config.motion = motion;
   config.frames = 61;
@@ -51,7 +52,7 @@ std::vector<ScaleCheckFrame> estimated(const test::Scene& scene, double scale, d
 }
 
 TEST(ScaleCheck, FindsTheScaleAndTheTiltOfATrajectoryThatHasThemWrong) {
-  const test::Scene scene = drive(test::Motion::kCarInABend);
+  const test::Scene scene = scaleDrive(test::Motion::kCarInABend);
   const ScaleCheck check = checkScale(estimated(scene, 0.8, 1.0 * kDeg), test::testImuCam(), {});
   ASSERT_TRUE(check.ok) << check.why;
   EXPECT_NEAR(check.scale, 1 / 0.8, 1e-3);
@@ -65,7 +66,7 @@ TEST(ScaleCheck, FindsTheScaleAndTheTiltOfATrajectoryThatHasThemWrong) {
 }
 
 TEST(ScaleCheck, ARightTrajectoryIsLeftAlone) {
-  const test::Scene scene = drive(test::Motion::kCarInABend);
+  const test::Scene scene = scaleDrive(test::Motion::kCarInABend);
   const ScaleCheck check = checkScale(estimated(scene, 1.0, 0.0, 0.01), test::testImuCam(), {});
   ASSERT_TRUE(check.ok) << check.why;
   EXPECT_NEAR(check.scale, 1.0, 3 * check.rel_sigma);
@@ -74,7 +75,7 @@ TEST(ScaleCheck, ARightTrajectoryIsLeftAlone) {
 }
 
 TEST(ScaleCheck, WithPositionNoiseTheScaleIsWithinItsSigma) {
-  const test::Scene scene = drive(test::Motion::kCarInABend);
+  const test::Scene scene = scaleDrive(test::Motion::kCarInABend);
   const ScaleCheck check = checkScale(estimated(scene, 1.2, -0.5 * kDeg, 0.01), test::testImuCam(), {});
   ASSERT_TRUE(check.ok) << check.why;
   EXPECT_LT(check.rel_sigma, 0.03);
@@ -84,7 +85,7 @@ TEST(ScaleCheck, WithPositionNoiseTheScaleIsWithinItsSigma) {
 
 TEST(ScaleCheck, AtConstantVelocityTheScaleIsReportedUndetermined) {
   // No acceleration: any scale explains the IMU, and the sigma must say so rather than the scale.
-  const test::Scene scene = drive(test::Motion::kConstantVelocity);
+  const test::Scene scene = scaleDrive(test::Motion::kConstantVelocity);
   const ScaleCheck check = checkScale(estimated(scene, 0.8, 0.0, 0.02), test::testImuCam(), {});
   if (check.ok) {
     EXPECT_GT(check.rel_sigma, 0.1) << "scale " << check.scale;
@@ -93,7 +94,7 @@ TEST(ScaleCheck, AtConstantVelocityTheScaleIsReportedUndetermined) {
 
 // The check's signal: the world-frame acceleration's std over the keyframe intervals, as the truth has it.
 TEST(ScaleCheck, ReportsTheAccelerationStdItMeasuresTheScaleBy) {
-  const test::Scene bend = drive(test::Motion::kCarInABend);
+  const test::Scene bend = scaleDrive(test::Motion::kCarInABend);
   std::vector<Eigen::Vector3d> a;
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (std::size_t k = 1; k < bend.v_world.size(); ++k) {
@@ -106,7 +107,7 @@ TEST(ScaleCheck, ReportsTheAccelerationStdItMeasuresTheScaleBy) {
   ASSERT_TRUE(check.ok) << check.why;
   EXPECT_GT(check.acc_std, 0.3);
   EXPECT_NEAR(check.acc_std, std::sqrt(var), 0.02 * std::sqrt(var));
-  const test::Scene steady = drive(test::Motion::kConstantVelocity);
+  const test::Scene steady = scaleDrive(test::Motion::kConstantVelocity);
   const ScaleCheck still = checkScale(estimated(steady, 1.0, 0.0), test::testImuCam(), {});
   EXPECT_LT(still.acc_std, 0.01);
 }
@@ -114,7 +115,7 @@ TEST(ScaleCheck, ReportsTheAccelerationStdItMeasuresTheScaleBy) {
 // What the window's vio.scale_check_bias_sigma stands for: an accelerometer bias error the check does not estimate
 // errs the scale by up to the error over the acceleration's std (here, in a bend, the tilt takes most of it).
 TEST(ScaleCheck, AnUnmodelledAccelerometerBiasErrsTheScaleByLessThanItOverTheAccelerationStd) {
-  const test::Scene scene = drive(test::Motion::kCarInABend);
+  const test::Scene scene = scaleDrive(test::Motion::kCarInABend);
   const double bias_error = 0.1;  // [m/s^2]
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<ScaleCheckFrame> frames = estimated(scene, 1.0, 0.0);
@@ -128,7 +129,7 @@ TEST(ScaleCheck, AnUnmodelledAccelerometerBiasErrsTheScaleByLessThanItOverTheAcc
 }
 
 TEST(ScaleCheck, ImuThatDoesNotCoverAnIntervalIsAnError) {
-  const test::Scene scene = drive(test::Motion::kCarInABend);
+  const test::Scene scene = scaleDrive(test::Motion::kCarInABend);
   std::vector<ScaleCheckFrame> frames = estimated(scene, 1.0, 0.0);
   frames[5].imu.erase(frames[5].imu.begin());
   EXPECT_THROW(checkScale(frames, test::testImuCam(), {}), std::invalid_argument);

@@ -7,7 +7,7 @@
 namespace drover::vio::test {
 namespace {
 
-VioConfig base() {
+VioConfig failureBase() {
   VioConfig c;
   c.estimate_time_offset = false;
   c.max_features = 60;
@@ -34,7 +34,7 @@ void expectReset(const FrameResult& r, const std::string& words) {
 TEST(WindowFailure, HealthyRunNeverResets) {
   const WindowScene scene;
   WindowRun run{scene};
-  EXPECT_FALSE(firstReset(base(), 5, run, scene).reset);
+  EXPECT_FALSE(firstReset(failureBase(), 5, run, scene).reset);
 }
 
 TEST(WindowFailure, TooFewTrackedFeaturesResets) {
@@ -43,13 +43,13 @@ TEST(WindowFailure, TooFewTrackedFeaturesResets) {
   run.edit = [](double t, std::vector<FrameFeature>& fs) {
     if (t > 2 && fs.size() > 4) fs.resize(4);  // a textureless stretch
   };
-  expectReset(firstReset(base(), 4, run, scene), "features tracked");
+  expectReset(firstReset(failureBase(), 4, run, scene), "features tracked");
 }
 
 TEST(WindowFailure, ImplausibleAccelerometerBiasResets) {
   const WindowScene scene;  // true accelerometer bias 0.054 m/s^2
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.max_acc_bias = 0.02;
   expectReset(firstReset(c, 8, run, scene), "accelerometer bias");
 }
@@ -58,7 +58,7 @@ TEST(WindowFailure, ImplausibleGyroBiasResets) {
   WindowScene scene;
   scene.gyro_bias = Eigen::Vector3d(0.03, 0, 0);
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.max_gyro_bias = 0.01;
   expectReset(firstReset(c, 8, run, scene), "gyro bias");
 }
@@ -66,7 +66,7 @@ TEST(WindowFailure, ImplausibleGyroBiasResets) {
 TEST(WindowFailure, PositionJumpResets) {
   const WindowScene scene;  // 1.5 m/s at 15 Hz: 0.1 m between frames
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.max_jump_m = 0.05;
   expectReset(firstReset(c, 4, run, scene), "position jumped");
 }
@@ -75,7 +75,7 @@ TEST(WindowFailure, HeightJumpResets) {
   WindowScene scene;
   scene.wave = 3.0;  // up to 2.1 m/s vertically: 0.14 m between frames
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.max_height_jump_m = 0.05;
   expectReset(firstReset(c, 4, run, scene), "height jumped");
 }
@@ -83,7 +83,7 @@ TEST(WindowFailure, HeightJumpResets) {
 TEST(WindowFailure, HeadingJumpResets) {
   const WindowScene scene;  // about 0.5 rad/s: 2 deg between frames
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.max_turn_deg = 0.5;
   expectReset(firstReset(c, 4, run, scene), "heading jumped");
 }
@@ -91,7 +91,7 @@ TEST(WindowFailure, HeadingJumpResets) {
 TEST(WindowFailure, ImplausibleSpeedResets) {
   const WindowScene scene;
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.max_speed = 1.0;  // the scene drives 1.5 m/s
   expectReset(firstReset(c, 4, run, scene), "speed");
 }
@@ -99,7 +99,7 @@ TEST(WindowFailure, ImplausibleSpeedResets) {
 TEST(WindowFailure, TimeOffsetBeyondItsLimitResets) {
   const WindowScene scene;
   WindowRun run{scene};
-  VioConfig c = base();
+  VioConfig c = failureBase();
   c.estimate_time_offset = true;
   c.max_time_offset_s = 0.004;
   expectReset(firstReset(c, 10, run, scene, 0.02), "time offset");
@@ -107,7 +107,7 @@ TEST(WindowFailure, TimeOffsetBeyondItsLimitResets) {
 
 TEST(WindowFailure, AnImuGapClearsTheWindowAndItReinitialises) {
   const WindowScene scene;
-  SlidingWindowEstimator est(base(), imu::PreintegrationConfig{}, scene.T_imu_cam, 460);
+  SlidingWindowEstimator est(failureBase(), imu::PreintegrationConfig{}, scene.T_imu_cam, 460);
   WindowRun run{scene};
   bool reset = false, again = false;
   for (double t = 0.05; t < 5; t += 1.0 / run.camera_hz) {

@@ -22,7 +22,7 @@ namespace {
 
 constexpr double kWallDistance = 8.0;  // [m]
 constexpr double kShiftPx = 0.37;      // [px] image motion a frame (sub-pixel, not a simple fraction)
-constexpr int kFrames = 16;            // 15 chained steps
+constexpr int kChainFrames = 16;            // 15 chained steps
 constexpr double kFrameS = 1.0 / 15;   // [s]
 
 World brickWall() {
@@ -57,7 +57,7 @@ double medianDriftPx(int pixel_samples) {
   const World world = brickWall();
   const SplineTrajectory trajectory = slidingTrajectory(config.intrinsics.fx);
   std::vector<cv::Mat> frames;
-  for (int k = 0; k < kFrames; ++k) {
+  for (int k = 0; k < kChainFrames; ++k) {
     const CameraFrame f =
         camera.render(world, trajectory, test::forwardCamera(), {}, fromSeconds(0.5 + k * kFrameS), 1, k);
     frames.push_back(cv::Mat(f.image.height, f.image.width, CV_8UC1, const_cast<std::uint8_t*>(f.image.data.data()))
@@ -69,7 +69,7 @@ double medianDriftPx(int pixel_samples) {
     for (int u = 220; u <= 420; u += 20) start.emplace_back(static_cast<float>(u), static_cast<float>(v));
   std::vector<cv::Point2f> at = start;
   std::vector<bool> alive(start.size(), true);
-  for (int k = 1; k < kFrames; ++k) {
+  for (int k = 1; k < kChainFrames; ++k) {
     std::vector<cv::Point2f> next;
     std::vector<uchar> status;
     std::vector<float> error;
@@ -83,7 +83,7 @@ double medianDriftPx(int pixel_samples) {
   std::vector<double> drift;
   for (std::size_t i = 0; i < start.size(); ++i) {
     if (!alive[i]) continue;
-    const cv::Point2f truth(start[i].x - static_cast<float>(kShiftPx * (kFrames - 1)), start[i].y);
+    const cv::Point2f truth(start[i].x - static_cast<float>(kShiftPx * (kChainFrames - 1)), start[i].y);
     drift.push_back(cv::norm(at[i] - truth));
   }
   EXPECT_GE(drift.size(), start.size() * 9 / 10) << "tracks lost";
