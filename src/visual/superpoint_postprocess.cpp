@@ -37,6 +37,9 @@ std::string SuperPointPostConfig::validate() const {
   if (nms_radius < 0) return "superpoint.nms_radius must be >= 0 px, got " + std::to_string(nms_radius);
   if (border < 0) return "superpoint.border must be >= 0 px, got " + std::to_string(border);
   if (min_keypoints < 0) return "superpoint.min_keypoints must be >= 0, got " + std::to_string(min_keypoints);
+  if (grid_cols < 0 || grid_rows < 0 || (grid_cols == 0) != (grid_rows == 0))
+    return "superpoint.grid_cols and grid_rows must both be >= 1, or both 0 (off), got " + std::to_string(grid_cols) +
+           " x " + std::to_string(grid_rows);
   return {};
 }
 
@@ -101,6 +104,22 @@ void SuperPointPostprocessor::suppress(int width, int height) {
   }
 }
 
+// Step 5's spread: kept_ (strongest first) reordered by each point's rank within its grid cell, ties by that order,
+// so that a top-k takes the best of every cell before the second of any.
+void SuperPointPostprocessor::spread(int width, int height) {
+  const int cols = config_.grid_cols, rows = config_.grid_rows;
+  if (cols == 0 || kept_.size() < 2) return;
+  std::vector<int> taken(static_cast<std::size_t>(cols) * rows, 0);
+  ranked_.clear();
+  for (const Candidate& c : kept_) {
+    const int cell = (c.y * rows / height) * cols + c.x * cols / width;
+    ranked_.push_back({taken[cell]++, c});
+  }
+  std::stable_sort(ranked_.begin(), ranked_.end(),
+                   [](const Ranked& a, const Ranked& b) { return a.rank < b.rank; });
+  for (std::size_t i = 0; i < kept_.size(); ++i) kept_[i] = ranked_[i].candidate;
+}
+
 // Step 6.
 void SuperPointPostprocessor::sampleDescriptors(const cv::Mat& desc, Keypoints& out) {
   const int hc = desc.size[2], wc = desc.size[3];
@@ -154,13 +173,17 @@ Keypoints SuperPointPostprocessor::run(const cv::Mat& semi, const cv::Mat& desc,
   if (kept_.size() < at_least) {  // step 5's floor: every unmasked pixel is a candidate
     collectCandidates(hc, wc, 0.0f, mask);
     suppress(width, height);
-    if (kept_.size() > at_least) kept_.resize(at_least);  // the above-threshold survivors come first and all stay
+    // By score the above-threshold survivors come first and all stay; spread, each cell's best come first.
+    spread(width, height);
+    if (kept_.size() > at_least) kept_.resize(at_least);
+  } else {
+    spread(width, height);
   }
   Keypoints out;
   const std::size_t n = std::min(kept_.size(), static_cast<std::size_t>(max_count));
   out.points.reserve(n);
   out.scores.reserve(n);
-  for (std::size_t i = 0; i < n; ++i) {  // kept_ is already strongest first
+  for (std::size_t i = 0; i < n; ++i) {  // kept_ is already in its order: strongest first, or spread
     out.points.emplace_back(static_cast<float>(kept_[i].x), static_cast<float>(kept_[i].y));
     out.scores.push_back(kept_[i].score);
   }

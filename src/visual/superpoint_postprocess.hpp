@@ -11,6 +11,12 @@
 //      again on every unmasked pixel, and the strongest fill up to that many: the absolute threshold, made for
 //      well-exposed images, otherwise leaves a dark frame nearly empty. Points above the threshold are the same
 //      either way, since NMS visits them first.)
+//      (Drover's spread, off by default: with a grid_cols x grid_rows grid the survivors are taken cell by cell, the
+//      strongest of every cell first, then every cell's second, ..., each round by score, for both the floor's
+//      fill and the max_count cut. The pretrained network scores a grid of ceiling lights far above a textured
+//      floor; by score alone a detection puts its keypoints on the ceiling, and a ground robot's monocular VIS loses
+//      the floor, the one surface that holds its scale (bench/RESULTS.md, the lighting course). ORB's FAST cells and
+//      VINS-Mono's min-distance mask spread their corners the same way.)
 //   6. descriptors: the coarse 256-d map is L2-normalised per cell (as SuperPointNet.forward), sampled bilinearly
 //      at the keypoint, the cell centre of cell (cx, cy) being pixel (8 cx + 3.5, 8 cy + 3.5), clamped to the
 //      outer cell centres, and L2-normalised again.
@@ -28,6 +34,8 @@ struct SuperPointPostConfig {
   int nms_radius = 4;                   // [network px] NMS half-window (demo: 4)
   int border = 4;                       // [network px] keypoints this close to the edge are dropped (demo: 4)
   int min_keypoints = 0;                // floor (see step 5): below-threshold points fill up to this many; 0 = off
+  int grid_cols = 0;                    // spread (see step 5) over this many columns x rows of the image; 0 = off
+  int grid_rows = 0;
   std::string validate() const;         // empty = valid
 };
 
@@ -48,13 +56,19 @@ class SuperPointPostprocessor {
   void softmax(const cv::Mat& semi);
   void collectCandidates(int hc, int wc, float threshold, const cv::Mat& mask);
   void suppress(int width, int height);
+  void spread(int width, int height);
   void sampleDescriptors(const cv::Mat& desc, Keypoints& out);
 
   SuperPointPostConfig config_;
   // Buffers reused between frames (sized on the first frame of a size).
   cv::Mat max_logit_, sum_exp_, exp_, tmp_, inv_norm_;
   cv::Mat suppressed_;
+  struct Ranked {
+    int rank;  // within its grid cell, 0 = the cell's strongest
+    Candidate candidate;
+  };
   std::vector<Candidate> candidates_, kept_;
+  std::vector<Ranked> ranked_;
 };
 
 }  // namespace drover::visual

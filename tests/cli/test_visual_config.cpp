@@ -72,6 +72,8 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
       border: 6
       threads: 2
       min_keypoints: 40
+      grid_cols: 7
+      grid_rows: 5
 )");
   const visual::DetectorConfig& d = c.detector;
   EXPECT_EQ(d.type, DetectorType::kOrb);
@@ -93,6 +95,8 @@ TEST(VisualConfigReader, EveryKeyReachesItsOwnField) {
   EXPECT_EQ(d.superpoint.post.border, 6);
   EXPECT_EQ(d.superpoint.threads, 2);
   EXPECT_EQ(d.superpoint.post.min_keypoints, 40);
+  EXPECT_EQ(d.superpoint.post.grid_cols, 7);
+  EXPECT_EQ(d.superpoint.post.grid_rows, 5);
 }
 
 TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {

@@ -2,6 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "visual/superpoint_postprocess.hpp"
 
@@ -140,6 +142,68 @@ TEST(SuperPointPostprocess, MaxCountKeepsTheStrongest) {
   EXPECT_EQ(k.points[0], cv::Point2f(50, 24));
   EXPECT_EQ(k.points[1], cv::Point2f(40, 24));
   EXPECT_TRUE(post.run(semi, cv::Mat(), cv::Mat(), 0).points.empty());
+}
+
+// A ceiling of strong peaks in the top half, a floor of weak ones in the bottom half (the lighting course's frames):
+// by score a top-3 is all ceiling; spread over a 2 x 2 grid it takes each cell's best first.
+TEST(SuperPointPostprocess, SpreadOverAGridTakesEveryCellsStrongestBeforeAnyCellsSecond) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 10, 8, 0.9);   // cell (0, 0)
+  setProbability(semi, 20, 8, 0.85);  // cell (0, 0)
+  setProbability(semi, 45, 8, 0.8);   // cell (1, 0)
+  setProbability(semi, 55, 8, 0.75);  // cell (1, 0)
+  setProbability(semi, 12, 40, 0.1);  // cell (0, 1), the floor's best
+  setProbability(semi, 22, 40, 0.05);
+  setProbability(semi, 50, 40, 0.2);  // cell (1, 1)
+  SuperPointPostConfig cfg;
+  SuperPointPostprocessor by_score(cfg);
+  Keypoints k = by_score.run(semi, cv::Mat(), cv::Mat(), 3);
+  ASSERT_EQ(k.points.size(), 3u);
+  for (const cv::Point2f& p : k.points) EXPECT_LT(p.y, 24) << "by score alone the ceiling takes all three";
+  cfg.grid_cols = cfg.grid_rows = 2;
+  SuperPointPostprocessor spread(cfg);
+  k = spread.run(semi, cv::Mat(), cv::Mat(), 7);
+  ASSERT_EQ(k.points.size(), 7u);
+  // Rank 0 of each cell, by score; then rank 1 of each, by score.
+  const std::vector<cv::Point2f> expected = {{10, 8}, {45, 8}, {50, 40}, {12, 40}, {20, 8}, {55, 8}, {22, 40}};
+  for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_EQ(k.points[i], expected[i]) << i;
+  EXPECT_NEAR(k.scores[3], 0.1, 1e-6) << "scores stay each point's own";
+  k = spread.run(semi, cv::Mat(), cv::Mat(), 4);
+  ASSERT_EQ(k.points.size(), 4u);
+  EXPECT_EQ(k.points[3], cv::Point2f(12, 40)) << "a top-4 holds the floor's best of both cells";
+}
+
+// The floor's fill below the threshold is spread too: a dark floor's best point comes in before a lit ceiling's
+// second, where by score the ceiling's weak points would fill the floor's quota.
+TEST(SuperPointPostprocess, TheFloorsFillIsSpreadOverTheGridWhenOneIsSet) {
+  cv::Mat semi = emptySemi();
+  setProbability(semi, 10, 8, 0.5);     // above 0.015, top half
+  setProbability(semi, 30, 8, 0.012);   // below, top half
+  setProbability(semi, 50, 8, 0.011);   // below, top half
+  setProbability(semi, 20, 40, 0.002);  // below, bottom half: the dark floor
+  SuperPointPostConfig cfg;
+  cfg.min_keypoints = 2;
+  Keypoints k = run(semi, cv::Mat(), cfg);
+  ASSERT_EQ(k.points.size(), 2u);
+  EXPECT_EQ(k.points[1], cv::Point2f(30, 8)) << "by score: the top half's weak point";
+  cfg.grid_cols = 1;
+  cfg.grid_rows = 2;
+  k = run(semi, cv::Mat(), cfg);
+  ASSERT_EQ(k.points.size(), 2u);
+  EXPECT_EQ(k.points[0], cv::Point2f(10, 8));
+  EXPECT_EQ(k.points[1], cv::Point2f(20, 40)) << "spread: the bottom row's best";
+}
+
+TEST(SuperPointPostprocess, AGridNeedsBothSidesOrNeither) {
+  SuperPointPostConfig cfg;
+  EXPECT_EQ(cfg.validate(), "") << "off by default";
+  cfg.grid_cols = 8;
+  EXPECT_NE(cfg.validate().find("grid_rows"), std::string::npos);
+  cfg.grid_rows = 6;
+  EXPECT_EQ(cfg.validate(), "");
+  cfg.grid_rows = -1;
+  EXPECT_NE(cfg.validate(), "");
+  EXPECT_THROW(SuperPointPostprocessor{cfg}, std::invalid_argument);
 }
 
 TEST(SuperPointPostprocess, DescriptorsAreBilinearBetweenCellCentresAndUnitLength) {

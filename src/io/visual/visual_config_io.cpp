@@ -37,6 +37,8 @@ void bindSuperPoint(YamlSection& s, visual::SuperPointConfig& c) {
       .bind("nms_radius", c.post.nms_radius)
       .bind("border", c.post.border)
       .bind("min_keypoints", c.post.min_keypoints)
+      .bind("grid_cols", c.post.grid_cols)
+      .bind("grid_rows", c.post.grid_rows)
       .bind("threads", c.threads);
 }
 

@@ -8,7 +8,8 @@
 //       orb:          n_features, scale_factor, n_levels, fast_threshold [grey levels], edge_threshold [px]
 //       superpoint:   weights (ONNX file; relative = to the working directory, else beside the config file),
 //                     input_width, input_height [px], max_keypoints, confidence_threshold, nms_radius [px],
-//                     border [px], threads, min_keypoints (floor below the threshold; 0 = off)
+//                     border [px], threads, min_keypoints (floor below the threshold; 0 = off), grid_cols,
+//                     grid_rows (spread over a grid of the image; 0 = off)
 //     tracker:        max_features, min_distance [px], flow_window [px], flow_levels, flow_iterations,
 //                     flow_epsilon [px], min_eigenvalue (LK's minEigThreshold), forward_backward (bool),
 //                     forward_backward_px [px], border_px [px],
