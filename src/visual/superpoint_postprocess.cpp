@@ -104,8 +104,8 @@ void SuperPointPostprocessor::suppress(int width, int height) {
   }
 }
 
-// Step 5's spread: kept_ (strongest first) reordered by each point's rank within its grid cell, ties by that order,
-// so that a top-k takes the best of every cell before the second of any.
+// Step 5's spread: kept_ (strongest first) reordered by each point's rank within its grid cell, equal ranks by score
+// (a stable sort), so that a top-k takes the best of every cell before the second of any.
 void SuperPointPostprocessor::spread(int width, int height) {
   const int cols = config_.grid_cols, rows = config_.grid_rows;
   if (cols == 0 || kept_.size() < 2) return;
@@ -170,15 +170,14 @@ Keypoints SuperPointPostprocessor::run(const cv::Mat& semi, const cv::Mat& desc,
   collectCandidates(hc, wc, static_cast<float>(config_.confidence_threshold), mask);
   suppress(width, height);
   const std::size_t at_least = static_cast<std::size_t>(std::min(config_.min_keypoints, max_count));
-  if (kept_.size() < at_least) {  // step 5's floor: every unmasked pixel is a candidate
+  const bool fill = kept_.size() < at_least;
+  if (fill) {  // step 5's floor: every unmasked pixel is a candidate
     collectCandidates(hc, wc, 0.0f, mask);
     suppress(width, height);
-    // By score the above-threshold survivors come first and all stay; spread, each cell's best come first.
-    spread(width, height);
-    if (kept_.size() > at_least) kept_.resize(at_least);
-  } else {
-    spread(width, height);
   }
+  spread(width, height);
+  // By score the above-threshold survivors come first and all stay; spread, every cell's best come first.
+  if (fill && kept_.size() > at_least) kept_.resize(at_least);
   Keypoints out;
   const std::size_t n = std::min(kept_.size(), static_cast<std::size_t>(max_count));
   out.points.reserve(n);
