@@ -4,7 +4,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
@@ -18,6 +17,7 @@
 #include "apps/drover/run_folder.hpp"
 #include "apps/drover/run_output.hpp"
 #include "apps/drover/run_preset.hpp"
+#include "apps/drover/run_progress.hpp"
 #include "apps/drover/run_realtime.hpp"
 #include "apps/drover/run_vis.hpp"
 #include "io/config.hpp"
@@ -37,7 +37,6 @@ namespace {
 constexpr std::size_t kLookahead = 32;
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 struct RunOptions {
   std::string dataset, format, config, out, preset;
@@ -47,30 +46,6 @@ struct RunOptions {
   double start = 0, duration = 0;  // [s] from the first measurement; duration 0 = to the end
   double rate = 1.0;               // [-] --realtime: sensor seconds per wall second
   std::size_t max_frames = 0;      // KITTI odometry: first N frames only
-};
-
-// Prints "scan N, t / T s (p%), x real time, ETA" about every 2 s of wall time.
-class RunProgress {
- public:
-  explicit RunProgress(double total_s) : total_s_(total_s), wall_start_(Clock::now()), last_(wall_start_) {}
-  void update(std::size_t scans, double data_s) {
-    const auto now = Clock::now();
-    if (now - last_ < std::chrono::seconds(2)) return;
-    last_ = now;
-    const double rtf = data_s / std::max(1e-9, wallSeconds());
-    if (total_s_ > 0) {
-      const double eta = rtf > 0 ? std::max(0.0, total_s_ - data_s) / rtf : 0.0;
-      spdlog::info("run: scan {}, {:.1f} / {:.1f} s ({:.0f}%), {:.1f}x real time, ETA {:.0f} s", scans, data_s, total_s_,
-                   100.0 * std::min(1.0, data_s / total_s_), rtf, eta);
-    } else {
-      spdlog::info("run: scan {}, {:.1f} s of data, {:.1f}x real time", scans, data_s, rtf);
-    }
-  }
-  double wallSeconds() const { return std::chrono::duration<double>(Clock::now() - wall_start_).count(); }
-
- private:
-  double total_s_;
-  Clock::time_point wall_start_, last_;
 };
 
 io::DatasetOptions datasetOptions(const RunOptions& o) {
