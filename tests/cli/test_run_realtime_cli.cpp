@@ -19,13 +19,11 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
-std::string realtimeConfig() { return std::string(DROVER_SOURCE_DIR) + "/config/farm_sim.yaml"; }
-
 // config/farm_sim.yaml with a sweep queue that holds the whole course: the test suite runs beside this test, and a
 // sweep dropped because of it would make the live trajectory differ from the replay's (a queue of 2 drops nothing
 // on a quiet machine, bench/RESULTS.md).
 std::string deepQueueConfig(const TempDir& dir) {
-  std::ifstream in(realtimeConfig());
+  std::ifstream in(config("farm_sim.yaml"));
   std::stringstream text;
   text << in.rdbuf() << "\nlive:\n  sweep_queue: 100\n";
   writeText(dir / "platform.yaml", text.str());

@@ -8,14 +8,13 @@
 
 #include "io/error.hpp"
 #include "io/visual/visual_config_io.hpp"
+#include "support/cli.hpp"
 #include "support/temp_dir.hpp"
 
 namespace drover::io {
 namespace {
 
 using visual::DetectorType;
-
-std::string shippedConfig(const std::string& name) { return std::string(DROVER_SOURCE_DIR) + "/config/" + name; }
 
 VisualConfig loadVisual(const test::TempDir& dir, const std::string& text) {
   const auto path = dir / "visual.yaml";
@@ -39,13 +38,13 @@ TEST(VisualConfigReader, ShippedConfigsChooseSuperPointWithTheSharedWeights) {
   for (const char* name : {"kitti.yaml", "euroc.yaml", "farm_sim.yaml"}) {
     SCOPED_TRACE(name);
     VisualConfig c;
-    ASSERT_NO_THROW(c = loadVisualConfig(shippedConfig(name)));
+    ASSERT_NO_THROW(c = loadVisualConfig(test::config(name)));
     EXPECT_EQ(c.detector.type, DetectorType::kSuperPoint);
     EXPECT_EQ(c.detector.superpoint.weights, "../shared/models/superpoint_v1.onnx");
     EXPECT_EQ(c.detector.validate(), "");
   }
-  EXPECT_DOUBLE_EQ(loadVisualConfig(shippedConfig("euroc.yaml")).detector.shi_tomasi.min_dist, 30.0);
-  EXPECT_EQ(loadVisualConfig(shippedConfig("kitti.yaml")).detector.shi_tomasi.max_cnt, 200);
+  EXPECT_DOUBLE_EQ(loadVisualConfig(test::config("euroc.yaml")).detector.shi_tomasi.min_dist, 30.0);
+  EXPECT_EQ(loadVisualConfig(test::config("kitti.yaml")).detector.shi_tomasi.max_cnt, 200);
 }
 
 TEST(VisualConfigReader, AFileWithoutAVisualSectionGivesTheDefaults) {
@@ -113,6 +112,19 @@ TEST(VisualConfigReader, UnknownKeysAndBadValuesNameFileLineAndKey) {
   EXPECT_TRUE(hasPart(e, "visual.detector.orb.n_levels")) << e;
   e = visualErrorOf(dir, "visual:\n  detectors: {}\n");
   EXPECT_TRUE(hasPart(e, "visual.detectors")) << e;
+}
+
+TEST(VisualConfigReader, AGridWithOneSideOrANegativeSideIsRefusedNamingTheSection) {
+  test::TempDir dir;
+  std::string e = visualErrorOf(dir, "visual:\n  detector:\n    superpoint:\n      grid_cols: 8\n");
+  EXPECT_TRUE(hasPart(e, "visual.yaml")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.detector.superpoint")) << e;
+  EXPECT_TRUE(hasPart(e, "grid_rows")) << e;
+  e = visualErrorOf(dir, "visual:\n  detector:\n    superpoint:\n      grid_cols: -8\n      grid_rows: 6\n");
+  EXPECT_TRUE(hasPart(e, "must both be >= 1")) << e;
+  e = visualErrorOf(dir, "visual:\n  detector:\n    superpoint:\n      grid_rows: six\n");
+  EXPECT_TRUE(hasPart(e, "line 4")) << e;
+  EXPECT_TRUE(hasPart(e, "visual.detector.superpoint.grid_rows")) << e;
 }
 
 TEST(VisualConfigReader, ValuesThatFailValidationNameTheSectionAndItsLine) {
@@ -202,7 +214,7 @@ TEST(VisualConfigReader, TrackerAndDepthKeysReachTheirFields) {
 TEST(VisualConfigReader, ShippedConfigsGiveTheTrackerAndDepthDefaults) {
   for (const char* name : {"kitti.yaml", "euroc.yaml", "farm_sim.yaml"}) {
     SCOPED_TRACE(name);
-    const VisualConfig c = loadVisualConfig(shippedConfig(name));
+    const VisualConfig c = loadVisualConfig(test::config(name));
     const visual::FeatureTrackerConfig t;
     EXPECT_EQ(c.tracker.max_features, t.max_features);
     EXPECT_DOUBLE_EQ(c.tracker.forward_backward_px, t.forward_backward_px);
