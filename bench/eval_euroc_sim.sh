@@ -19,13 +19,16 @@ DETECTORS=${DETECTORS:-shi-tomasi orb superpoint}
 TD=${CAMERA_TIME_OFFSET:-}
 mkdir -p bench/out/euroc_sim "$OUT_ROOT/sim" "$OUT_ROOT/euroc_configs" "$OUT_ROOT/runs"
 
-# A sequence rendered with the config's rays a pixel (scenario.json records them).
+# A sequence rendered with the config's rays a pixel and texture filter (scenario.json records them).
 current() {  # dir
   local want have
   [ -f "$1/scenario.json" ] || return 1
   want=$(sed -n 's/^ *camera_pixel_samples: *\([0-9][0-9]*\).*/\1/p' config/euroc.yaml)
   have=$(sed -n 's/.*"camera_pixel_samples": *\([0-9][0-9]*\).*/\1/p' "$1/scenario.json")
-  [ "${want:-1}" = "${have:-0}" ]
+  [ "${want:-1}" = "${have:-0}" ] || return 1
+  want=$(sed -n 's/^ *camera_texture_filter: *\([a-z]*\).*/\1/p' config/euroc.yaml)
+  have=$(sed -n 's/.*"camera_texture_filter": *\([a-z]*\).*/\1/p' "$1/scenario.json")
+  [ "${want:-false}" = "${have:-false}" ]
 }
 
 SIM_CONFIG=config/euroc.yaml

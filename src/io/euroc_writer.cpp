@@ -58,6 +58,7 @@ std::string scenarioJson(const SimScenarioInfo& s, const SimSensorInfo& sensors)
   j["path_length_m"] = s.path_length_m;
   j["closes_loop"] = s.closes_loop;
   j["camera_pixel_samples"] = sensors.camera_pixel_samples;  // rays per pixel side the frames were rendered with
+  j["camera_texture_filter"] = sensors.camera_texture_filter;
   return j.dump(2) + "\n";
 }
 

@@ -66,6 +66,8 @@ void readKey(const YAML::Node& n, const std::string& key, const std::string& fil
     (key == "lidar_time_offset" ? s.lidar_time_offset_s : s.camera_time_offset_s) = v;
   } else if (key == "camera_color") {
     s.camera_color = boolean(n, key, file);
+  } else if (key == "camera_texture_filter") {
+    s.camera_texture_filter = boolean(n, key, file);
   } else if (key == "noise") {
     s.noise = boolean(n, key, file);
   } else if (key == "ground_truth_rate_hz") {
@@ -93,7 +95,7 @@ SimConfigSettings loadSimConfigSettings(const std::string& yaml_path) {
   static const std::vector<std::string> known = {
       "lidar_model",    "lidar_rate_hz", "lidar_columns",        "camera_rate_hz",    "camera_color",
       "imu_rate_hz",    "noise",         "ground_truth_rate_hz", "lidar_time_offset", "camera_time_offset",
-      "camera_pixel_samples", "rig"};
+      "camera_pixel_samples", "camera_texture_filter", "rig"};
   for (const auto& kv : sim) {
     const std::string key = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), key) == known.end()) {

@@ -52,6 +52,11 @@ class YamlMap {
     return static_cast<int>(v);
   }
   bool has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+  bool boolean(const std::string& key) const {
+    const std::string v = text(key);
+    if (v != "true" && v != "false") fail(file_, record(get(key), key), "expected true or false, found " + v);
+    return v == "true";
+  }
   Time seconds(const std::string& key) const { return parseSeconds(text(key), file_, record(get(key), key)); }
   std::vector<double> numbers(const std::string& key) const {
     const YAML::Node n = get(key);
@@ -133,6 +138,7 @@ SimSensorInfo readSensors(const YamlMap& m) {
   s.camera_exposure_s = camera.number("exposure_s");
   // Datasets written before the key are point-sampled.
   s.camera_pixel_samples = camera.has("pixel_samples") ? camera.integer("pixel_samples", 1, 4) : 1;
+  s.camera_texture_filter = camera.has("texture_filter") && camera.boolean("texture_filter");
   const YamlMap imu = m.map("imu");
   s.imu_rate_hz = imu.positive("rate_hz");
   s.gyro_noise_density = imu.number("gyro_noise_density");

@@ -50,6 +50,11 @@ struct CameraModelConfig {
   // px a frame (bench/RESULTS.md). N averages N x N rays spread evenly over the pixel's area, as a sensor pixel
   // integrates the light falling on it (a box filter; costs N^2 rays a pixel and sub-frame). 1 ... 4.
   int pixel_samples = 1;
+  // Each ray's texture is its average over the surface the ray stands for (distance / (fx * pixel_samples), widened
+  // by 1 / sqrt(cos) on slanted surfaces: the square of the ray's footprint's area) instead of its value at one point
+  // (sim/texture.hpp). A few rays a pixel leave 2-4 cm texture seen from 5-15 m aliased (the farm's metal roofs:
+  // moire that moves unlike the surface); this removes it at no ray cost, as more rays a pixel would at N^2 the cost.
+  bool texture_filter = false;
   double noise_sigma = 2.0;            // [grey levels of 255], Gaussian read noise
   bool color = false;                  // false: mono8 (as most VIO cameras); true: bgr8
   Eigen::Vector3f sky = Eigen::Vector3f(0.7f, 0.8f, 0.95f);  // linear RGB where no surface is hit (outdoors)

@@ -29,11 +29,23 @@ float lightAt(const Illumination& illumination, Time t, const Eigen::Vector3d& p
   return illumination ? illumination(t, p_world) : 1.0f;
 }
 
+// Slanted surfaces stretch a ray's footprint by 1 / cos(incidence); this bounds it at grazing incidence.
+constexpr double kMinFootprintCos = 0.05;
+
+// The width [m] of surface a ray of `ray_angle` [rad] stands for where it hits: the side of a square of its
+// footprint's area (distance * angle by distance * angle / cos). 0 when ray_angle is 0 (point sampling).
+double footprintAt(const Hit& hit, const Eigen::Vector3d& direction, double ray_angle) {
+  if (!(ray_angle > 0)) return 0.0;
+  const double cos_incidence = std::max(std::abs(hit.normal.dot(direction)), kMinFootprintCos);
+  return hit.distance * ray_angle / std::sqrt(cos_incidence);
+}
+
 // Linear RGB arriving along one camera ray at one sub-frame.
 // textureless: the surface's plain colour (the white-walls material with the surface's colour) instead of its texture.
+// ray_angle: the angle [rad] one ray stands for when textures are filtered (CameraModelConfig::texture_filter), or 0.
 Eigen::Vector3f radiance(const World& world, const Illumination& illumination, const Eigen::Vector3f& sky,
                          Time t, const Eigen::Matrix3d& R_world_cam, const Eigen::Vector3d& origin_world,
-                         const Eigen::Vector3d& ray_cam, bool textureless) {
+                         const Eigen::Vector3d& ray_cam, bool textureless, double ray_angle) {
   const Ray ray{origin_world, R_world_cam * ray_cam};
   if (const std::optional<Hit> hit = world.intersect(ray)) {
     const float light = lightAt(illumination, t, hit->point) * lambertFactor(hit->normal);
@@ -42,7 +54,7 @@ Eigen::Vector3f radiance(const World& world, const Illumination& illumination, c
       plain.texture = Texture::kWhite;
       return shade(plain, hit->uv) * light;
     }
-    return shade(*hit->material, hit->uv) * light;
+    return shade(*hit->material, hit->uv, footprintAt(*hit, ray.direction.normalized(), ray_angle)) * light;
   }
   return sky * lightAt(illumination, t, ray.origin + kSkyDistance * ray.direction);
 }
@@ -55,19 +67,23 @@ void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& 
   const float inv_samples = 1.0f / static_cast<float>(subframes.size());
   const auto per_pixel = static_cast<std::size_t>(config_.pixel_samples * config_.pixel_samples);
   const float inv_area = 1.0f / static_cast<float>(per_pixel);
+  const double ray_angle =
+      config_.texture_filter ? 1.0 / (config_.intrinsics.fx * static_cast<double>(config_.pixel_samples)) : 0.0;
   for (int u = 0; u < width; ++u) {
     const std::uint64_t pixel = static_cast<std::uint64_t>(v) * width_ + static_cast<std::uint64_t>(u);
     Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
     if (rays_area_.empty()) {
       const Eigen::Vector3d ray_cam = rays_cam_[pixel].cast<double>();
       for (const SubFrame& s : subframes)
-        rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless);
+        rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless,
+                        ray_angle);
       rgb *= inv_samples * 255.0f;
     } else {
       for (std::size_t k = pixel * per_pixel; k < (pixel + 1) * per_pixel; ++k) {
         const Eigen::Vector3d ray_cam = rays_area_[k].cast<double>();
         for (const SubFrame& s : subframes)
-          rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless);
+          rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless,
+                        ray_angle);
       }
       rgb *= inv_samples * inv_area * 255.0f;
     }

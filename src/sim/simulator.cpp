@@ -320,6 +320,7 @@ io::SimDatasetDescription Simulator::datasetDescription() const {
   s.camera_channels = config_.camera.color ? 3 : 1;
   s.camera_exposure_s = config_.camera.exposure_s;
   s.camera_pixel_samples = config_.camera.pixel_samples;
+  s.camera_texture_filter = config_.camera.texture_filter;
   const ImuModelConfig& imu = config_.imu;
   s.imu_rate_hz = imu.rate_hz;
   // The densities of the data as generated: zero when the model's noise is off.

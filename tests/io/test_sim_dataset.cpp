@@ -37,6 +37,7 @@ SimDatasetDescription description() {
   k.distortion_coeffs = {-0.1, 0.01, 1e-4, -2e-4};
   d.sensors.gyro_noise_density = 1.7e-4;
   d.sensors.camera_pixel_samples = 3;
+  d.sensors.camera_texture_filter = true;
   d.scenario.name = "hand-made";
   d.scenario.seed = 42;
   d.scenario.duration_s = 1.5;
@@ -190,6 +191,7 @@ TEST(SimDataset, CalibrationGroundTruthAndScenarioReadBack) {
   EXPECT_EQ(r.sensors.gyro_noise_density, 1.7e-4);
   EXPECT_EQ(r.sensors.lidar_model, "vlp16");
   EXPECT_EQ(r.sensors.camera_pixel_samples, 3);
+  EXPECT_TRUE(r.sensors.camera_texture_filter);
   EXPECT_NE(reader->describe().find("hand-made"), std::string::npos);
 }
 
@@ -293,6 +295,19 @@ TEST(SimDatasetReader, CameraPixelSamplesOutOfRangeIsNamed) {
   expectIoError([&] { openSimDataset(dir.string(), {}); }, {"calibration.yaml", "sensors.camera.pixel_samples", "[1, 4]"});
 }
 
+// Frames rendered before the texture filter existed were point-sampled textures: no key reads as false.
+TEST(SimDatasetReader, TheTextureFilterIsReadAsWrittenFalseWhenAbsentAndAWordIsNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "calibration.yaml", "    texture_filter: true", "    texture_filter: yes please");
+  expectIoError([&] { openSimDataset(dir.string(), {}); },
+                {"calibration.yaml", "sensors.camera.texture_filter", "true or false", "yes please"});
+  replaceInFile(dir / "calibration.yaml", "    texture_filter: yes please", "    texture_filter: false");
+  EXPECT_FALSE(readSimDescription(dir.string()).sensors.camera_texture_filter);
+  replaceInFile(dir / "calibration.yaml", "    texture_filter: false", "");
+  EXPECT_FALSE(readSimDescription(dir.string()).sensors.camera_texture_filter);
+}
+
 TEST(SimDatasetReader, ScanFileSizeNotAMultipleOfTheRecordIsNamed) {
   TempDir tmp;
   const fs::path dir = writeDataset(tmp);
@@ -392,13 +407,15 @@ TEST(SimDatasetReader, RingBeyondTheLidarsRingsIsNamed) {
 TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
   TempDir tmp;
   test::writeText(tmp / "a.yaml", "dataset:\n  load_lidar: true\nsim:\n  lidar_model: hdl64\n  camera_rate_hz: 20\n"
-                                  "  camera_color: true\n  camera_time_offset: -0.002\n  camera_pixel_samples: 2\n");
+                                  "  camera_color: true\n  camera_time_offset: -0.002\n  camera_pixel_samples: 2\n"
+                                  "  camera_texture_filter: true\n");
   const SimConfigSettings s = loadSimConfigSettings((tmp / "a.yaml").string());
   EXPECT_EQ(s.lidar_model, "hdl64");
   EXPECT_EQ(s.camera_rate_hz, 20.0);
   EXPECT_EQ(s.camera_color, true);
   EXPECT_EQ(s.camera_time_offset_s, -0.002);
   EXPECT_EQ(s.camera_pixel_samples, 2);
+  EXPECT_EQ(s.camera_texture_filter, true);
   EXPECT_FALSE(s.imu_rate_hz.has_value());
   test::writeText(tmp / "b.yaml", "sim:\n  lidar_modle: vlp32\n");
   expectIoError([&] { loadSimConfigSettings((tmp / "b.yaml").string()); }, {"b.yaml", "line 2", "sim.lidar_modle"});
@@ -428,6 +445,7 @@ TEST(SimConfigSettings, RatesAndOffsetsShareTheOptionsRanges) {
   error("lidar_time_offset: 2", {"key 'sim.lidar_time_offset'", "[-1, 1] s"});
   error("lidar_columns: 0", {"key 'sim.lidar_columns'", "[1, 100000]"});
   error("camera_pixel_samples: 5", {"key 'sim.camera_pixel_samples'", "[1, 4]"});
+  error("camera_texture_filter: 2", {"key 'sim.camera_texture_filter'"});
 }
 
 TEST(SimConfigSettings, FarmSimConfigIsAValidPlatformAndSimConfig) {
