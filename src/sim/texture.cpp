@@ -3,11 +3,13 @@
 // horizontally and v up on vertical surfaces (see World::intersect), which bricks, fences and pens rely on.
 // Feature sizes are 0.03-1.2 m times material.scale so images have strong gradients at 1-10 m viewing distance.
 // Filtering: with a footprint f > 0 (the width of surface one camera ray stands for, texture.hpp) each pattern
-// returns its average over an f-wide box instead of its value at a point: noise octaves finer than the footprint
-// fade to their mean, and lines (mortar, seams, bars) become the share of the box they cover (box-filtered pulse
-// trains, Apodaca & Gritz, Advanced RenderMan, Sec. 11.4). That is what a sensor pixel integrating the light does,
-// and what a few rays a pixel cannot do for 2-4 cm detail seen from 5-15 m (the patterns then alias: moire that moves
-// unlike the surface). With f = 0 every pattern is its point value, bit for bit as before the footprint existed.
+// approximates its average over an f-wide box instead of its value at a point: each noise octave keeps the share of
+// its deviation from its mean that best predicts that average (axisWeight: all of it for cells much larger than f,
+// nothing once f spans many cells), and lines (mortar, seams, bars) become the share of the box they cover
+// (box-filtered pulse trains, Apodaca & Gritz, Advanced RenderMan, Sec. 11.4). That is what a sensor pixel
+// integrating the light does, and what a few rays a pixel cannot do for 2-4 cm detail seen from 5-15 m (the patterns
+// then alias: moire that moves unlike the surface). With f = 0 every pattern is its point value, bit for bit as before
+// the footprint existed.
 #include "sim/texture.hpp"
 
 #include <algorithm>
