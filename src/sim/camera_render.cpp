@@ -83,7 +83,7 @@ void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& 
         const Eigen::Vector3d ray_cam = rays_area_[k].cast<double>();
         for (const SubFrame& s : subframes)
           rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless,
-                        ray_angle);
+                          ray_angle);
       }
       rgb *= inv_samples * inv_area * 255.0f;
     }
