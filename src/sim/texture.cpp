@@ -118,6 +118,15 @@ inline Vector3f cover(double c, const Vector3f& line, const Vector3f& between) {
   return static_cast<float>(c) * line + static_cast<float>(1.0 - c) * between;
 }
 
+// The same with colours that cost a noise lookup: only those with a share are computed (at a zero footprint every
+// share is 0 or 1, so one).
+template <typename Line, typename Between>
+Vector3f coverLazily(double c, const Line& line, const Between& between) {
+  if (c >= 1.0) return line();
+  if (c <= 0.0) return between();
+  return cover(c, line(), between());
+}
+
 Vector3f brick(const Material& m, std::uint64_t key, const Eigen::Vector2d& uv, double s, double f) {
   const double h = 0.075 * s, w = 0.225 * s, mortar = 0.015 * s;
   std::int64_t row = 0, col = 0;
@@ -136,13 +145,13 @@ Vector3f brick(const Material& m, std::uint64_t key, const Eigen::Vector2d& uv, 
 }
 
 Vector3f fence(const Material& m, std::uint64_t key, const Eigen::Vector2d& uv, double s, double f) {
-  const Vector3f post = m.albedo * (0.7f + 0.6f * fbm(key, uv, 0.04 * s, 0.4 * s, 2, f));       // vertical grain
-  const Vector3f rail = m.albedo * (0.7f + 0.6f * fbm(key + 7, uv, 0.4 * s, 0.04 * s, 2, f));   // horizontal grain
-  const Vector3f gap = m.albedo * (0.12f + 0.15f * fbm(key + 13, uv, 0.2 * s, 0.2 * s, 2, f));  // dark gap behind
+  const auto post = [&] { return Vector3f(m.albedo * (0.7f + 0.6f * fbm(key, uv, 0.04 * s, 0.4 * s, 2, f))); };
+  const auto rail = [&] { return Vector3f(m.albedo * (0.7f + 0.6f * fbm(key + 7, uv, 0.4 * s, 0.04 * s, 2, f))); };
+  const auto gap = [&] { return Vector3f(m.albedo * (0.12f + 0.15f * fbm(key + 13, uv, 0.2 * s, 0.2 * s, 2, f))); };
+  // Posts (vertical grain) in front of rails (horizontal grain) in front of the dark gap behind the fence.
   const double c_post = pulseCoverage(uv.x(), 1.2 * s, 0.12 * s, f);
   const double c_rail = pulseCoverage(uv.y(), 0.4 * s, 0.08 * s, f);
-  if (!(f > 0)) return c_post > 0 ? post : (c_rail > 0 ? rail : gap);
-  return cover(c_post, post, cover(c_rail, rail, gap));
+  return coverLazily(c_post, post, [&] { return coverLazily(c_rail, rail, gap); });
 }
 
 // A round bar or rail of width `width` at `x` within it: its highlight across the width, or, once the footprint
@@ -185,15 +194,15 @@ Vector3f carPaint(const Material& m, std::uint64_t key, const Eigen::Vector2d& u
 Vector3f metal(const Material& m, std::uint64_t key, const Eigen::Vector2d& uv, double s, double f) {
   std::int64_t i = 0, j = 0;
   const double fu = wrap(uv.x(), 1.0 * s, i), fv = wrap(uv.y(), 0.5 * s, j);
-  const Vector3f seam = m.albedo * 0.25f;
-  const Vector3f panel = m.albedo * (0.55f + 0.8f * fbm(key, uv, 0.6 * s, 0.04 * s, 2, f));  // brushed streaks along u
   const double ru = fu - 0.06 * s, rv = fv - 0.06 * s;
   // A rivet near each panel corner (0.04 m across at scale 1): dropped once the footprint is a quarter of it (its
   // share of a footprint's box is then small; a point test would put all of it into every box it touches).
   const bool rivet = ru * ru + rv * rv < 0.0004 * s * s && !(f > 0.01 * s);
-  if (!(f > 0)) return fu < 0.02 * s || fv < 0.02 * s ? seam : (rivet ? Vector3f(m.albedo * 1.3f) : panel);
+  const auto panel = [&] {  // brushed streaks along u, or the rivet
+    return Vector3f(rivet ? m.albedo * 1.3f : m.albedo * (0.55f + 0.8f * fbm(key, uv, 0.6 * s, 0.04 * s, 2, f)));
+  };
   const double cu = pulseCoverage(uv.x(), 1.0 * s, 0.02 * s, f), cv = pulseCoverage(uv.y(), 0.5 * s, 0.02 * s, f);
-  return cover(1.0 - (1.0 - cu) * (1.0 - cv), seam, rivet ? Vector3f(m.albedo * 1.3f) : panel);
+  return coverLazily(1.0 - (1.0 - cu) * (1.0 - cv), [&] { return Vector3f(m.albedo * 0.25f); }, panel);  // seams
 }
 
 Vector3f clamp01(const Vector3f& c) { return c.cwiseMax(0.0f).cwiseMin(1.0f); }
