@@ -77,11 +77,14 @@ void BM_SimLidarSweepVlp16(benchmark::State& state) {
 }
 BENCHMARK(BM_SimLidarSweepVlp16)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Arg: rays per pixel side (sim.camera_pixel_samples; the farm configs ship 2).
+// Args: rays per pixel side (sim.camera_pixel_samples; the farm configs ship 2), edge rays per pixel side
+// (sim.camera_edge_pixel_samples, 0 = off), texture filter (sim.camera_texture_filter, 0/1).
 void BM_SimCameraFrame640x480(benchmark::State& state) {
   const sim::Scenario& s = farm();
   sim::SimulatorConfig c = sim::SimulatorConfig::defaults();
   c.camera.pixel_samples = static_cast<int>(state.range(0));
+  c.camera.edge_pixel_samples = static_cast<int>(state.range(1));
+  c.camera.texture_filter = state.range(2) != 0;
   const sim::CameraRenderer renderer(c.camera);
   std::uint64_t k = 0;
   for (auto _ : state) {
@@ -91,7 +94,16 @@ void BM_SimCameraFrame640x480(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_SimCameraFrame640x480)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SimCameraFrame640x480)
+    ->ArgNames({"rays", "edge", "filter"})
+    ->Args({1, 0, 0})
+    ->Args({2, 0, 0})
+    ->Args({2, 0, 1})
+    ->Args({3, 0, 1})
+    ->Args({2, 4, 1})
+    ->Args({4, 0, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void BM_SimImu60s(benchmark::State& state) {
   const sim::Scenario& s = farm();

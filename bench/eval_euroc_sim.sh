@@ -19,16 +19,17 @@ DETECTORS=${DETECTORS:-shi-tomasi orb superpoint}
 TD=${CAMERA_TIME_OFFSET:-}
 mkdir -p bench/out/euroc_sim "$OUT_ROOT/sim" "$OUT_ROOT/euroc_configs" "$OUT_ROOT/runs"
 
-# A sequence rendered with the config's rays a pixel and texture filter (scenario.json records them).
+# A sequence rendered with the config's camera rays (scenario.json records them). KEY:DEFAULT:ABSENT: the config's
+# default, and what a sequence from before the key had (sequences from before pixel samples are stale).
 current() {  # dir
-  local want have
+  local k key default absent want have
   [ -f "$1/scenario.json" ] || return 1
-  want=$(sed -n 's/^ *camera_pixel_samples: *\([0-9][0-9]*\).*/\1/p' config/euroc.yaml)
-  have=$(sed -n 's/.*"camera_pixel_samples": *\([0-9][0-9]*\).*/\1/p' "$1/scenario.json")
-  [ "${want:-1}" = "${have:-0}" ] || return 1
-  want=$(sed -n 's/^ *camera_texture_filter: *\([a-z]*\).*/\1/p' config/euroc.yaml)
-  have=$(sed -n 's/.*"camera_texture_filter": *\([a-z]*\).*/\1/p' "$1/scenario.json")
-  [ "${want:-false}" = "${have:-false}" ]
+  for k in camera_pixel_samples:1:0 camera_texture_filter:false:false camera_edge_pixel_samples:0:0; do
+    IFS=: read -r key default absent <<< "$k"
+    want=$(sed -n "s/^ *$key: *\([0-9a-z]*\).*/\1/p" config/euroc.yaml)
+    have=$(sed -n "s/.*\"$key\": *\([0-9a-z]*\).*/\1/p" "$1/scenario.json")
+    [ "${want:-$default}" = "${have:-$absent}" ] || return 1
+  done
 }
 
 SIM_CONFIG=config/euroc.yaml

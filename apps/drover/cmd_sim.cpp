@@ -101,6 +101,7 @@ sim::SimulatorConfig simulatorConfig(const SimOptions& o) {
   if (s.camera_color) c.camera.color = *s.camera_color;
   if (s.camera_pixel_samples) c.camera.pixel_samples = *s.camera_pixel_samples;
   if (s.camera_texture_filter) c.camera.texture_filter = *s.camera_texture_filter;
+  if (s.camera_edge_pixel_samples) c.camera.edge_pixel_samples = *s.camera_edge_pixel_samples;
   if (s.imu_rate_hz) c.imu.rate_hz = *s.imu_rate_hz;
   if (s.ground_truth_rate_hz) c.ground_truth_rate_hz = *s.ground_truth_rate_hz;
   if (s.lidar_time_offset_s) c.lidar_time_offset = fromSeconds(*s.lidar_time_offset_s);

@@ -59,6 +59,7 @@ std::string scenarioJson(const SimScenarioInfo& s, const SimSensorInfo& sensors)
   j["closes_loop"] = s.closes_loop;
   j["camera_pixel_samples"] = sensors.camera_pixel_samples;  // rays per pixel side the frames were rendered with
   j["camera_texture_filter"] = sensors.camera_texture_filter;
+  j["camera_edge_pixel_samples"] = sensors.camera_edge_pixel_samples;  // 0: every pixel with the same rays
   return j.dump(2) + "\n";
 }
 

@@ -68,6 +68,8 @@ void readKey(const YAML::Node& n, const std::string& key, const std::string& fil
     s.camera_color = boolean(n, key, file);
   } else if (key == "camera_texture_filter") {
     s.camera_texture_filter = boolean(n, key, file);
+  } else if (key == "camera_edge_pixel_samples") {
+    s.camera_edge_pixel_samples = static_cast<int>(parseInteger(scalar(n, key, file), 0, 4, source(n, key, file)));
   } else if (key == "noise") {
     s.noise = boolean(n, key, file);
   } else if (key == "ground_truth_rate_hz") {
@@ -95,7 +97,7 @@ SimConfigSettings loadSimConfigSettings(const std::string& yaml_path) {
   static const std::vector<std::string> known = {
       "lidar_model",    "lidar_rate_hz", "lidar_columns",        "camera_rate_hz",    "camera_color",
       "imu_rate_hz",    "noise",         "ground_truth_rate_hz", "lidar_time_offset", "camera_time_offset",
-      "camera_pixel_samples", "camera_texture_filter", "rig"};
+      "camera_pixel_samples", "camera_texture_filter", "camera_edge_pixel_samples", "rig"};
   for (const auto& kv : sim) {
     const std::string key = kv.first.Scalar();
     if (std::find(known.begin(), known.end(), key) == known.end()) {
@@ -104,6 +106,13 @@ SimConfigSettings loadSimConfigSettings(const std::string& yaml_path) {
       fail(yaml_path, keyRecord(kv.first, key), "unknown key (expected one of: " + list + ")");
     }
     readKey(kv.second, key, yaml_path, s);
+  }
+  // Edge rays refine a pixel whose first rays disagree: there must be several first rays, and fewer.
+  const int first = s.camera_pixel_samples.value_or(1), edge = s.camera_edge_pixel_samples.value_or(0);
+  if (edge > 0 && (first < 2 || edge <= first)) {
+    fail(yaml_path, "key 'sim.camera_edge_pixel_samples'",
+         "must be 0 (off) or more than sim.camera_pixel_samples (" + std::to_string(first) +
+             "), which must then be at least 2; got " + std::to_string(edge));
   }
   return s;
 }

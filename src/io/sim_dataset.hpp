@@ -76,6 +76,7 @@ struct SimSensorInfo {
   double camera_exposure_s = 0.01;       // [s]
   int camera_pixel_samples = 1;          // rays per pixel side (sim::CameraModelConfig::pixel_samples)
   bool camera_texture_filter = false;    // textures averaged over each ray's footprint (CameraModelConfig)
+  int camera_edge_pixel_samples = 0;     // rays per pixel side where a pixel's rays disagree; 0 = off
   double imu_rate_hz = 200.0;            // [Hz]
   double gyro_noise_density = 0;         // [rad/s/sqrt(Hz)]
   double accel_noise_density = 0;        // [m/s^2/sqrt(Hz)]
@@ -210,6 +211,7 @@ struct SimConfigSettings {
   std::optional<bool> camera_color;              // bgr8 instead of mono8
   std::optional<int> camera_pixel_samples;       // rays per pixel side, 1 ... 4 (sim::CameraModelConfig)
   std::optional<bool> camera_texture_filter;     // textures averaged over each ray's footprint
+  std::optional<int> camera_edge_pixel_samples;  // rays per pixel side where a pixel's rays disagree: 0 (off) ... 4
   std::optional<double> imu_rate_hz;             // [Hz]
   std::optional<double> ground_truth_rate_hz;    // [Hz], >= 100
   std::optional<double> lidar_time_offset_s;     // [s], t_imu = t_lidar + offset

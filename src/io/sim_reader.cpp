@@ -139,6 +139,7 @@ SimSensorInfo readSensors(const YamlMap& m) {
   // Datasets written before the key are point-sampled.
   s.camera_pixel_samples = camera.has("pixel_samples") ? camera.integer("pixel_samples", 1, 4) : 1;
   s.camera_texture_filter = camera.has("texture_filter") && camera.boolean("texture_filter");
+  s.camera_edge_pixel_samples = camera.has("edge_pixel_samples") ? camera.integer("edge_pixel_samples", 0, 4) : 0;
   const YamlMap imu = m.map("imu");
   s.imu_rate_hz = imu.positive("rate_hz");
   s.gyro_noise_density = imu.number("gyro_noise_density");

@@ -44,7 +44,9 @@ std::string calibrationYaml(const SimDatasetDescription& d) {
        std::to_string(s.camera_channels) + "  # 1 = mono8, 3 = bgr8\n    exposure_s: " +
        formatDouble(s.camera_exposure_s) + "  # [s]\n    pixel_samples: " + std::to_string(s.camera_pixel_samples) +
        "  # rays per pixel side (1: the pixel's centre only)\n    texture_filter: " +
-       std::string(s.camera_texture_filter ? "true" : "false") + "  # textures averaged over each ray's footprint\n";
+       std::string(s.camera_texture_filter ? "true" : "false") + "  # textures averaged over each ray's footprint\n" +
+       "    edge_pixel_samples: " + std::to_string(s.camera_edge_pixel_samples) +
+       "  # rays per pixel side where the pixel's rays disagree (0: off)\n";
   y += "  imu:\n    rate_hz: " + formatDouble(s.imu_rate_hz) + "  # [Hz]\n";
   y += "    gyro_noise_density: " + formatDouble(s.gyro_noise_density) + "  # [rad/s/sqrt(Hz)]\n";
   y += "    accel_noise_density: " + formatDouble(s.accel_noise_density) + "  # [m/s^2/sqrt(Hz)]\n";

@@ -63,6 +63,10 @@ std::string CameraModelConfig::validate() const {
     error << "camera motion_blur_samples must be in [1, 64], got " << motion_blur_samples;
   } else if (pixel_samples < 1 || pixel_samples > 4) {
     error << "camera pixel_samples must be in [1, 4], got " << pixel_samples;
+  } else if (edge_pixel_samples != 0 &&
+             (pixel_samples < 2 || edge_pixel_samples <= pixel_samples || edge_pixel_samples > 4)) {
+    error << "camera edge_pixel_samples must be 0 (off) or in (pixel_samples, 4] with pixel_samples >= 2, got "
+          << edge_pixel_samples << " with pixel_samples " << pixel_samples;
   } else if (!(noise_sigma >= 0) || !std::isfinite(noise_sigma)) {
     error << "camera noise_sigma must be >= 0 and finite, got " << noise_sigma;
   } else if (!sky.allFinite() || sky.minCoeff() < 0) {
@@ -85,21 +89,8 @@ CameraRenderer::CameraRenderer(const CameraModelConfig& config) : config_(config
       }
     }
   });
-  const int n = config_.pixel_samples;
-  if (n > 1) {
-    const std::size_t per_pixel = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
-    rays_area_.resize(rays_cam_.size() * per_pixel);
-    tbb::parallel_for(tbb::blocked_range<int>(0, k.height), [&](const tbb::blocked_range<int>& rows) {
-      for (int v = rows.begin(); v != rows.end(); ++v) {
-        for (int u = 0; u < k.width; ++u) {
-          Eigen::Vector3f* out = &rays_area_[(static_cast<std::size_t>(v) * width_ + u) * per_pixel];
-          for (int b = 0; b < n; ++b)
-            for (int a = 0; a < n; ++a)
-              *out++ = unproject(Eigen::Vector2d(u + (a + 0.5) / n - 0.5, v + (b + 0.5) / n - 0.5)).cast<float>();
-        }
-      }
-    });
-  }
+  if (config_.pixel_samples > 1) rays_area_ = areaRays(config_.pixel_samples);
+  if (config_.edge_pixel_samples > 0) rays_edge_ = areaRays(config_.edge_pixel_samples);
   // The field of view the image covers, in |xn|^2, from the rays through the image border (with margin).
   double max_r2 = 0;
   for (const Eigen::Vector3f& r : rays_cam_) {
@@ -107,6 +98,23 @@ CameraRenderer::CameraRenderer(const CameraModelConfig& config) : config_(config
                                   (static_cast<double>(r.z()) * r.z()));
   }
   max_r2_ = 1.2 * max_r2;
+}
+
+std::vector<Eigen::Vector3f> CameraRenderer::areaRays(int n) const {
+  const CameraIntrinsics& k = config_.intrinsics;
+  const std::size_t per_pixel = static_cast<std::size_t>(n) * static_cast<std::size_t>(n);
+  std::vector<Eigen::Vector3f> rays(width_ * static_cast<std::size_t>(k.height) * per_pixel);
+  tbb::parallel_for(tbb::blocked_range<int>(0, k.height), [&](const tbb::blocked_range<int>& rows) {
+    for (int v = rows.begin(); v != rows.end(); ++v) {
+      for (int u = 0; u < k.width; ++u) {
+        Eigen::Vector3f* out = &rays[(static_cast<std::size_t>(v) * width_ + u) * per_pixel];
+        for (int b = 0; b < n; ++b)
+          for (int a = 0; a < n; ++a)
+            *out++ = unproject(Eigen::Vector2d(u + (a + 0.5) / n - 0.5, v + (b + 0.5) / n - 0.5)).cast<float>();
+      }
+    }
+  });
+  return rays;
 }
 
 Eigen::Vector3d CameraRenderer::unproject(const Eigen::Vector2d& pixel) const {

@@ -55,6 +55,13 @@ struct CameraModelConfig {
   // (sim/texture.hpp). A few rays a pixel leave 2-4 cm texture seen from 5-15 m aliased (the farm's metal roofs:
   // moire that moves unlike the surface); this removes it at no ray cost, as more rays a pixel would at N^2 the cost.
   bool texture_filter = false;
+  // Rays per pixel side where the pixel's pixel_samples^2 rays disagree: 0 = off, else in (pixel_samples, 4] with
+  // pixel_samples >= 2. Texture filtered over each ray's footprint leaves a pixel's rays nearly equal; they differ
+  // where an edge, a light boundary or a thin object crosses the pixel, and there a few rays leave its share of each
+  // side off by up to 1 / (2 pixel_samples) of the contrast, a step that moves unlike the edge as the view moves
+  // sub-pixel. Such a pixel is rendered again with edge_pixel_samples^2 rays (its first rays are dropped: they lie
+  // off the finer grid), so edges get the finer box filter and flat surfaces cost pixel_samples^2 rays.
+  int edge_pixel_samples = 0;
   double noise_sigma = 2.0;            // [grey levels of 255], Gaussian read noise
   bool color = false;                  // false: mono8 (as most VIO cameras); true: bgr8
   Eigen::Vector3f sky = Eigen::Vector3f(0.7f, 0.8f, 0.95f);  // linear RGB where no surface is hit (outdoors)
@@ -119,6 +126,13 @@ class CameraRenderer {
   struct SubFrame;
   void renderRow(const World& world, const std::vector<SubFrame>& subframes, const Illumination& illumination,
                  int v, float* row, bool textureless) const;
+  // Linear RGB along `count` rays summed over the rays and the sub-frames; *luma_spread: the largest minus the
+  // smallest luma of the rays (each summed over the sub-frames). ray_angle [rad]: the angle one ray stands for (filter), or 0.
+  Eigen::Vector3f raysRadiance(const World& world, const std::vector<SubFrame>& subframes,
+                               const Illumination& illumination, const Eigen::Vector3f* rays, std::size_t count,
+                               bool textureless, double ray_angle, float* luma_spread) const;
+  // samples^2 unit rays through the sub-pixel centres of every pixel, pixel after pixel.
+  std::vector<Eigen::Vector3f> areaRays(int samples) const;
 
   CameraModelConfig config_;
   std::size_t width_ = 0;
@@ -127,6 +141,7 @@ class CameraRenderer {
   // pixel_samples > 1: pixel_samples^2 unit rays per pixel, pixel after pixel (row-major), through the pixel's
   // sub-pixel centres (u + (a + 0.5) / N - 0.5, v + (b + 0.5) / N - 0.5)
   std::vector<Eigen::Vector3f> rays_area_;
+  std::vector<Eigen::Vector3f> rays_edge_;  // edge_pixel_samples > 0: the same for edge_pixel_samples^2 rays
 };
 
 }  // namespace drover::sim

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/camera_model.hpp"
 #include "sim/gaussian_quantiles.hpp"
@@ -59,36 +60,62 @@ Eigen::Vector3f radiance(const World& world, const Illumination& illumination, c
   return sky * lightAt(illumination, t, ray.origin + kSkyDistance * ray.direction);
 }
 
+// Luma of linear RGB (ITU-R BT.601 weights): the mono camera's grey.
+float luma(const Eigen::Vector3f& rgb) { return 0.299f * rgb.x() + 0.587f * rgb.y() + 0.114f * rgb.z(); }
+
+// A pixel is rendered again with edge_pixel_samples^2 rays when its rays' luma spread exceeds this share of its mean
+// luma plus kEdgeSpreadFloor [linear units, 1 = white in daylight]. Relative, because the sensor's gain multiplies a
+// dark scene's contrasts up to full scale.
+constexpr float kEdgeSpread = 0.25f;
+constexpr float kEdgeSpreadFloor = 1e-6f;
+
 }  // namespace
+
+Eigen::Vector3f CameraRenderer::raysRadiance(const World& world, const std::vector<SubFrame>& subframes,
+                                             const Illumination& illumination, const Eigen::Vector3f* rays,
+                                             std::size_t count, bool textureless, double ray_angle,
+                                             float* luma_spread) const {
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (std::size_t k = 0; k < count; ++k) {
+    const Eigen::Vector3d ray_cam = rays[k].cast<double>();
+    Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
+    for (const SubFrame& s : subframes)
+      rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless,
+                      ray_angle);
+    const float y = luma(rgb);
+    lo = std::min(lo, y);
+    hi = std::max(hi, y);
+    sum += rgb;
+  }
+  *luma_spread = hi - lo;
+  return sum;
+}
 
 void CameraRenderer::renderRow(const World& world, const std::vector<SubFrame>& subframes,
                                const Illumination& illumination, int v, float* row, bool textureless) const {
   const int width = config_.intrinsics.width;
-  const float inv_samples = 1.0f / static_cast<float>(subframes.size());
-  const auto per_pixel = static_cast<std::size_t>(config_.pixel_samples * config_.pixel_samples);
-  const float inv_area = 1.0f / static_cast<float>(per_pixel);
-  const double ray_angle =
-      config_.texture_filter ? 1.0 / (config_.intrinsics.fx * static_cast<double>(config_.pixel_samples)) : 0.0;
+  const int n = config_.pixel_samples, m = config_.edge_pixel_samples;
+  const double fx = config_.intrinsics.fx;
+  const double ray_angle = config_.texture_filter ? 1.0 / (fx * n) : 0.0;
+  const double edge_ray_angle = config_.texture_filter && m > 0 ? 1.0 / (fx * m) : 0.0;
+  const std::size_t per_pixel = static_cast<std::size_t>(n * n), per_edge_pixel = static_cast<std::size_t>(m * m);
+  const Eigen::Vector3f* rays = rays_area_.empty() ? rays_cam_.data() : rays_area_.data();
+  const auto subframes_n = static_cast<float>(subframes.size());
   for (int u = 0; u < width; ++u) {
-    const std::uint64_t pixel = static_cast<std::uint64_t>(v) * width_ + static_cast<std::uint64_t>(u);
-    Eigen::Vector3f rgb = Eigen::Vector3f::Zero();
-    if (rays_area_.empty()) {
-      const Eigen::Vector3d ray_cam = rays_cam_[pixel].cast<double>();
-      for (const SubFrame& s : subframes)
-        rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless,
-                        ray_angle);
-      rgb *= inv_samples * 255.0f;
-    } else {
-      for (std::size_t k = pixel * per_pixel; k < (pixel + 1) * per_pixel; ++k) {
-        const Eigen::Vector3d ray_cam = rays_area_[k].cast<double>();
-        for (const SubFrame& s : subframes)
-          rgb += radiance(world, illumination, config_.sky, s.t, s.R_world_cam, s.origin_world, ray_cam, textureless,
-                          ray_angle);
-      }
-      rgb *= inv_samples * inv_area * 255.0f;
+    const std::size_t pixel = static_cast<std::size_t>(v) * width_ + static_cast<std::size_t>(u);
+    float spread = 0;
+    std::size_t count = per_pixel;
+    Eigen::Vector3f rgb = raysRadiance(world, subframes, illumination, rays + pixel * per_pixel, per_pixel,
+                                       textureless, ray_angle, &spread);
+    if (m > 0 && spread > kEdgeSpread * luma(rgb) / static_cast<float>(count) + kEdgeSpreadFloor * subframes_n) {
+      count = per_edge_pixel;
+      rgb = raysRadiance(world, subframes, illumination, rays_edge_.data() + pixel * count, count, textureless,
+                         edge_ray_angle, &spread);
     }
+    rgb *= 1.0f / subframes_n * (1.0f / static_cast<float>(count)) * 255.0f;
     if (!config_.color) {
-      row[u] = 0.299f * rgb.x() + 0.587f * rgb.y() + 0.114f * rgb.z();
+      row[u] = luma(rgb);
     } else {
       for (int c = 0; c < 3; ++c) row[3 * u + c] = rgb[2 - c];  // stored B, G, R
     }

@@ -321,6 +321,7 @@ io::SimDatasetDescription Simulator::datasetDescription() const {
   s.camera_exposure_s = config_.camera.exposure_s;
   s.camera_pixel_samples = config_.camera.pixel_samples;
   s.camera_texture_filter = config_.camera.texture_filter;
+  s.camera_edge_pixel_samples = config_.camera.edge_pixel_samples;
   const ImuModelConfig& imu = config_.imu;
   s.imu_rate_hz = imu.rate_hz;
   // The densities of the data as generated: zero when the model's noise is off.

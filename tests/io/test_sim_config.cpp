@@ -18,7 +18,7 @@ TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
   TempDir tmp;
   test::writeText(tmp / "a.yaml", "dataset:\n  load_lidar: true\nsim:\n  lidar_model: hdl64\n  camera_rate_hz: 20\n"
                                   "  camera_color: true\n  camera_time_offset: -0.002\n  camera_pixel_samples: 2\n"
-                                  "  camera_texture_filter: true\n");
+                                  "  camera_texture_filter: true\n  camera_edge_pixel_samples: 4\n");
   const SimConfigSettings s = loadSimConfigSettings((tmp / "a.yaml").string());
   EXPECT_EQ(s.lidar_model, "hdl64");
   EXPECT_EQ(s.camera_rate_hz, 20.0);
@@ -26,6 +26,7 @@ TEST(SimConfigSettings, ReadsKnownKeysAndRejectsUnknownOnes) {
   EXPECT_EQ(s.camera_time_offset_s, -0.002);
   EXPECT_EQ(s.camera_pixel_samples, 2);
   EXPECT_EQ(s.camera_texture_filter, true);
+  EXPECT_EQ(s.camera_edge_pixel_samples, 4);
   EXPECT_FALSE(s.imu_rate_hz.has_value());
   test::writeText(tmp / "b.yaml", "sim:\n  lidar_modle: vlp32\n");
   expectIoError([&] { loadSimConfigSettings((tmp / "b.yaml").string()); }, {"b.yaml", "line 2", "sim.lidar_modle"});
@@ -56,6 +57,22 @@ TEST(SimConfigSettings, RatesAndOffsetsShareTheOptionsRanges) {
   error("lidar_columns: 0", {"key 'sim.lidar_columns'", "[1, 100000]"});
   error("camera_pixel_samples: 5", {"key 'sim.camera_pixel_samples'", "[1, 4]"});
   error("camera_texture_filter: 2", {"key 'sim.camera_texture_filter'"});
+  error("camera_edge_pixel_samples: 5", {"key 'sim.camera_edge_pixel_samples'", "[0, 4]"});
+}
+
+// Edge rays refine a pixel whose first rays disagree: a pixel needs several first rays, and fewer than the edge's.
+TEST(SimConfigSettings, EdgePixelSamplesMustExceedThePixelSamples) {
+  TempDir tmp;
+  const auto load = [&](const std::string& text) {
+    test::writeText(tmp / "e.yaml", "sim:\n" + text);
+    return loadSimConfigSettings((tmp / "e.yaml").string());
+  };
+  EXPECT_EQ(load("  camera_pixel_samples: 2\n  camera_edge_pixel_samples: 3\n").camera_edge_pixel_samples, 3);
+  EXPECT_EQ(load("  camera_edge_pixel_samples: 0\n").camera_edge_pixel_samples, 0);
+  expectIoError([&] { load("  camera_pixel_samples: 2\n  camera_edge_pixel_samples: 2\n"); },
+                {"e.yaml", "sim.camera_edge_pixel_samples", "more than sim.camera_pixel_samples (2)", "got 2"});
+  expectIoError([&] { load("  camera_edge_pixel_samples: 4\n"); },
+                {"sim.camera_edge_pixel_samples", "more than sim.camera_pixel_samples (1)", "at least 2", "got 4"});
 }
 
 TEST(SimConfigSettings, FarmSimConfigIsAValidPlatformAndSimConfig) {

@@ -37,6 +37,7 @@ SimDatasetDescription description() {
   d.sensors.gyro_noise_density = 1.7e-4;
   d.sensors.camera_pixel_samples = 3;
   d.sensors.camera_texture_filter = true;
+  d.sensors.camera_edge_pixel_samples = 4;
   d.scenario.name = "hand-made";
   d.scenario.seed = 42;
   d.scenario.duration_s = 1.5;
@@ -191,6 +192,7 @@ TEST(SimDataset, CalibrationGroundTruthAndScenarioReadBack) {
   EXPECT_EQ(r.sensors.lidar_model, "vlp16");
   EXPECT_EQ(r.sensors.camera_pixel_samples, 3);
   EXPECT_TRUE(r.sensors.camera_texture_filter);
+  EXPECT_EQ(r.sensors.camera_edge_pixel_samples, 4);
   EXPECT_NE(reader->describe().find("hand-made"), std::string::npos);
 }
 
@@ -305,6 +307,17 @@ TEST(SimDatasetReader, TheTextureFilterIsReadAsWrittenFalseWhenAbsentAndAWordIsN
   EXPECT_FALSE(readSimDescription(dir.string()).sensors.camera_texture_filter);
   replaceInFile(dir / "calibration.yaml", "    texture_filter: false", "");
   EXPECT_FALSE(readSimDescription(dir.string()).sensors.camera_texture_filter);
+}
+
+// Frames rendered before edge rays existed took the same rays in every pixel: no key reads as 0 (off).
+TEST(SimDatasetReader, EdgePixelSamplesAreReadAsWrittenOffWhenAbsentAndOutOfRangeNamed) {
+  TempDir tmp;
+  const fs::path dir = writeDataset(tmp);
+  replaceInFile(dir / "calibration.yaml", "    edge_pixel_samples: 4", "    edge_pixel_samples: 8");
+  expectIoError([&] { openSimDataset(dir.string(), {}); },
+                {"calibration.yaml", "sensors.camera.edge_pixel_samples", "[0, 4]"});
+  replaceInFile(dir / "calibration.yaml", "    edge_pixel_samples: 8", "");
+  EXPECT_EQ(readSimDescription(dir.string()).sensors.camera_edge_pixel_samples, 0);
 }
 
 TEST(SimDatasetReader, ScanFileSizeNotAMultipleOfTheRecordIsNamed) {
