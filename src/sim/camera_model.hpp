@@ -127,7 +127,8 @@ class CameraRenderer {
   void renderRow(const World& world, const std::vector<SubFrame>& subframes, const Illumination& illumination,
                  int v, float* row, bool textureless) const;
   // Linear RGB along `count` rays summed over the rays and the sub-frames; *luma_spread: the largest minus the
-  // smallest luma of the rays (each summed over the sub-frames). ray_angle [rad]: the angle one ray stands for (filter), or 0.
+  // smallest luma of the rays (each summed over the sub-frames). ray_angle [rad]: the angle one ray stands for
+  // (texture_filter), or 0.
   Eigen::Vector3f raysRadiance(const World& world, const std::vector<SubFrame>& subframes,
                                const Illumination& illumination, const Eigen::Vector3f* rays, std::size_t count,
                                bool textureless, double ray_angle, float* luma_spread) const;

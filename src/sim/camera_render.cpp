@@ -1,7 +1,7 @@
-// CameraRenderer::renderRadiance: one ray per pixel, or pixel_samples^2 over its area (and per motion-blur sub-frame)
-// into the world, texture * light * Lambert shading. CameraRenderer::render: the ideal camera on top of it,
-// counter-based Gaussian read noise and 8-bit quantisation (linear, no gamma curve). The sensor with exposure and
-// gain is camera_exposure.cpp.
+// CameraRenderer::renderRadiance: one ray per pixel, or pixel_samples^2 over its area (and per motion-blur
+// sub-frame), edge_pixel_samples^2 where those disagree, into the world, texture * light * Lambert shading.
+// CameraRenderer::render: the ideal camera on top of it, counter-based Gaussian read noise and 8-bit quantisation
+// (linear, no gamma curve). The sensor with exposure and gain is camera_exposure.cpp.
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 

@@ -61,8 +61,9 @@ TEST(EdgePixelSamples, ConfigRefusesEdgeRaysWithoutSeveralFirstRaysOrNotFinerTha
   }
 }
 
-// A pixel whose 2 x 2 rays straddle the box's outline has its 4 x 4 value, every other pixel its 2 x 2 value. In the dark (light 1e-3) the same pixels are
-// refined: the test is relative, as a sensor's gain brings a dark scene's contrast back to full scale.
+// A pixel whose 2 x 2 rays straddle the box's outline has its 4 x 4 value, every other pixel its 2 x 2 value. In
+// the dark (light 1e-3) the same pixels are refined: the test is relative, as a sensor's gain brings a dark scene's
+// contrast back to full scale.
 TEST(EdgePixelSamples, APixelWhoseRaysDisagreeTakesTheFinerRaysAndOneWhoseRaysAgreeKeepsItsOwn) {
   const World world = edgeBoxWorld();
   const SplineTrajectory still = edgeStill();
