@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Drover's main job. Installs what is missing, builds, then
-#  1. generates the simulated farm course once (out/sim/farm, ~1 h on 2 cores for the camera's rays, 2x2 a pixel and
-#     4x4 where an edge crosses one;
+#  1. generates the simulated farm course once (out/sim/farm, ~25 min on 2 cores, most of it the camera's rays,
+#     2x2 a pixel and 4x4 where an edge crosses one;
 #     cached: delete the folder to regenerate; lidar, camera,
 #     IMU) and runs the full system on it -- the LIS, the VIS and loop closure -- twice, with the two presets of the
 #     LVI-SAM comparison: lvi-sam (out/farm_lvi-sam) and drover (out/farm: trajectory, map, report with loops, APE),
