@@ -357,7 +357,8 @@ void registerRun(CLI::App& app) {
   cmd->add_option("--without", o->without,
                   "Take a part out after the preset (repeatable; the ablation): vo-factor, vis-guess, vis-gates, "
                   "visual-yaw-prior, scan-context, radius-search, four-dof, loop-fitness-sigma, vis-carried-sigma, "
-                  "depth-factor, superpoint, lk-min-eigenvalue, keyframe-interval, keyframe-gap-speed")
+                  "depth-factor, superpoint, lk-min-eigenvalue, keyframe-interval, keyframe-gap-speed, "
+                  "lidar-rotation-sigma")
       ->check(CLI::IsMember(partNames()));
   cmd->add_flag("--no-imu", o->no_imu, "Lidar only: ignore the IMU (constant-velocity deskew and guess)");
   cmd->add_flag("--no-loop", o->no_loop, "No loop closure (odometry only; the keyframe graph is still kept)");

@@ -11,7 +11,8 @@
 //            15 m and 30 s verified by ICP (no Scan Context). Its visual DBoW2 loop detector is not reproduced.
 //   drover:  SuperPoint + KLT (SuperPoint's tracks held to a smallest gradient eigenvalue of 2e-3: none following a
 //            plain wall's image noise or sliding along an edge), lidar depth as factors, the VIS's motion as guess
-//            and factor behind the health gates with resets by the LIS, Scan Context with the VIS's yaw prior.
+//            and factor behind the health gates with resets by the LIS, Scan Context with the VIS's yaw prior, the
+//            scan match's attitude in the IMU smoother at 0.01 rad.
 #include <string>
 #include <vector>
 
@@ -34,7 +35,8 @@ void applyPreset(Preset preset, io::VisualConfig& visual, vio::VioConfig& vio);
 //   and the reset by the LIS), visual-yaw-prior (loop closure's VIS yaw), scan-context (radius loops instead),
 //   depth-factor (lidar depth held fixed instead), superpoint (Shi-Tomasi instead), lk-min-eigenvalue (SuperPoint's
 //   tracks at the platform's LK threshold), keyframe-interval (the VIS's keyframes by parallax alone, as VINS-Mono),
-//   keyframe-gap-speed (every keyframe gap while moving a stall, whatever the VIS's velocity).
+//   keyframe-gap-speed (every keyframe gap while moving a stall, whatever the VIS's velocity), lidar-rotation-sigma
+//   (the scan match's attitude in the IMU smoother at the platform's sigma, LIO-SAM's 0.05 rad, instead of 0.01 rad).
 std::vector<std::string> partNames();
 
 // A run's choice: the preset, then the parts taken out.

@@ -224,7 +224,6 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
             biasCovarianceAfter(toSeconds(out.t - previous.t)));
     return;
   }
-  const Eigen::Matrix<double, 6, 6> L = poseSqrtInformation(out, T_world_imu_measured);
   std::optional<backend::RelativePoseMeasurement> visual;
   // The VIS is checked (and watched) whenever the LIS takes it, as a factor or only as the matcher's guess.
   if ((config_.vis_fusion.factor || config_.vis_fusion.initial_guess) && !visual_.empty()) {
@@ -243,6 +242,7 @@ void ImuFusion::update(ScanOutcome& out, const Trajectory& trajectory) {
     visual = backend::RelativePoseMeasurement{Eigen::Isometry3d::Identity(), zeroMotionSqrtInformation()};
     out.vis_factor = false;
   }
+  const Eigen::Matrix<double, 6, 6> L = poseSqrtInformation(out, T_world_imu_measured, visual.has_value());
   backend::SmootherUpdate r;
   try {
     imu::Preintegrator pim(smoother_.bias(), config_.preintegration);
@@ -323,19 +323,23 @@ std::optional<VisualIncrement> ImuFusion::checkedVisualIncrement(Time a, Time b,
   return inc;
 }
 
-// Sigma of the lidar pose: lidar_sigma_position/rotation, plus degenerate_sigma along each degenerate direction of
-// the match (so the IMU carries those, e.g. along a featureless corridor), or degenerate_sigma on every axis when
-// the match failed. The covariance is built in the lidar's right-perturbation tangent [rho; phi] and mapped to the
-// smoother's error [dp_world; dtheta_imu]: xi_imu = Ad(T_imu_lidar) xi_lidar, dp_world = R_world_imu rho_imu.
-Eigen::Matrix<double, 6, 6> ImuFusion::poseSqrtInformation(const ScanOutcome& out,
-                                                           const Eigen::Isometry3d& T_world_imu) const {
+// Sigma of the lidar pose: lidar_sigma_position/rotation (lidar_sigma_rotation_unaided on a degenerate sweep without
+// a relative factor, when set), plus degenerate_sigma along each degenerate direction of the match (so the IMU
+// carries those, e.g. along a featureless corridor), or degenerate_sigma on every axis when the match failed. The
+// covariance is built in the lidar's right-perturbation tangent [rho; phi] and mapped to the smoother's error
+// [dp_world; dtheta_imu]: xi_imu = Ad(T_imu_lidar) xi_lidar, dp_world = R_world_imu rho_imu.
+Eigen::Matrix<double, 6, 6> ImuFusion::poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu,
+                                                           bool aided) const {
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
   Matrix6d cov_lidar = Matrix6d::Zero();
   if (!out.match_usable) {
     cov_lidar.diagonal().setConstant(config_.degenerate_sigma * config_.degenerate_sigma);
   } else {
+    const double sr = out.degenerate && !aided && config_.lidar_sigma_rotation_unaided > 0
+                          ? config_.lidar_sigma_rotation_unaided
+                          : config_.lidar_sigma_rotation;
     cov_lidar.diagonal() << Eigen::Vector3d::Constant(config_.lidar_sigma_position * config_.lidar_sigma_position),
-        Eigen::Vector3d::Constant(config_.lidar_sigma_rotation * config_.lidar_sigma_rotation);
+        Eigen::Vector3d::Constant(sr * sr);
     for (const geometry::Vector6d& d : out.degenerate_directions)
       cov_lidar += config_.degenerate_sigma * config_.degenerate_sigma * d.normalized() * d.normalized().transpose();
   }

@@ -89,7 +89,8 @@ class ImuFusion {
   // when the start was moving (true then).
   bool restartAfterMovingStart(ScanOutcome& out, const Eigen::Isometry3d& T_world_imu_measured,
                                const Trajectory& trajectory);
-  Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu) const;
+  Eigen::Matrix<double, 6, 6> poseSqrtInformation(const ScanOutcome& out, const Eigen::Isometry3d& T_world_imu,
+                                                  bool aided) const;
   std::optional<Eigen::Matrix<double, 6, 6>> biasCovarianceAfter(double gap) const;
   bool holdAtRest(const std::vector<ImuSample>& samples, Time a, Time b);
   Eigen::Matrix<double, 6, 6> zeroMotionSqrtInformation() const;

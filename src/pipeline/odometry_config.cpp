@@ -43,6 +43,8 @@ std::string OdometryConfig::validate() const {
                                 {"lidar_sigma_rotation", lidar_sigma_rotation},
                                 {"degenerate_sigma", degenerate_sigma}})
     if (!std::isfinite(v) || v <= 0) return std::string(name) + " must be finite and > 0, got " + std::to_string(v);
+  if (!std::isfinite(lidar_sigma_rotation_unaided) || lidar_sigma_rotation_unaided < 0)
+    return "lidar_sigma_rotation_unaided must be finite and >= 0, got " + std::to_string(lidar_sigma_rotation_unaided);
   const std::pair<const char*, std::string> parts[] = {
       {"layout", layout.validate()},          {"features", features.validate()},
       {"local_map", local_map.validate()},    {"matcher", matcher.validate()},

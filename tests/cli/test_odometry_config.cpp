@@ -137,6 +137,7 @@ TEST(OdometryConfigReader, EveryTopLevelKeyReachesItsOwnField) {
   const OdometryConfig c = load(dir,
                                 "odometry:\n  use_imu: false\n  deskew: false\n  min_points: 50\n  imu_wait: 0.2\n"
                                 "  lidar_sigma_position: 0.04\n  lidar_sigma_rotation: 0.03\n  degenerate_sigma: 5\n"
+                                "  lidar_sigma_rotation_unaided: 0.06\n"
                                 "  gravity_roll_pitch: false\n  deskew_refinements: 2\n"
                                 "  degenerate_restart_sweeps: 11\n  use_imu_orientation: false\n"
                                 "  moving_start_restart: 5\n  moving_start_speed: 0.4\n"
@@ -148,6 +149,11 @@ TEST(OdometryConfigReader, EveryTopLevelKeyReachesItsOwnField) {
   EXPECT_DOUBLE_EQ(c.lidar_sigma_position, 0.04);
   EXPECT_DOUBLE_EQ(c.lidar_sigma_rotation, 0.03);
   EXPECT_DOUBLE_EQ(c.degenerate_sigma, 5.0);
+  EXPECT_DOUBLE_EQ(c.lidar_sigma_rotation_unaided, 0.06);
+  EXPECT_EQ(OdometryConfig{}.lidar_sigma_rotation_unaided, 0.0) << "the same as lidar_sigma_rotation by default";
+  OdometryConfig negative;
+  negative.lidar_sigma_rotation_unaided = -0.01;
+  EXPECT_NE(negative.validate().find("lidar_sigma_rotation_unaided"), std::string::npos);
   EXPECT_FALSE(c.gravity_roll_pitch);
   EXPECT_EQ(c.deskew_refinements, 2);
   EXPECT_EQ(c.degenerate_restart_sweeps, 11);

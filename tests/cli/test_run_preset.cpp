@@ -4,6 +4,10 @@
 // the lvi-sam preset takes OpenCV's default, as LVI-SAM's tracker does.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <string>
+#include <vector>
+
 #include "apps/drover/run_preset.hpp"
 
 namespace drover::cli {
@@ -103,6 +107,30 @@ TEST(RunPreset, TheDroverPresetCountsAKeyframeGapAsAStallOnlyWhenTheVisVelocityL
   EXPECT_DOUBLE_EQ(fusionAfter({Preset::kPlatform, {}}, 0.3).keyframe_gap_velocity_tolerance, 0.3);
   EXPECT_DOUBLE_EQ(pipeline::VisualMotionConfig{}.keyframe_gap_velocity_tolerance, 0) << "the platform's default";
   EXPECT_GT(fusionAfter({Preset::kLviSam, {}}, 0).max_keyframe_gap, 1e9) << "no keyframe gate";
+}
+
+// The scan match's attitude in the IMU smoother: the drover preset holds it at 0.01 rad (LIO-SAM's 0.05 lets the
+// smoother's pitch ride on the accelerometer bias along a degenerate corridor) except on degenerate sweeps that no
+// relative factor aids; a tighter platform value stays, and the lvi-sam preset and --without lidar-rotation-sigma
+// keep the platform's.
+double lidarRotationSigmaAfter(const MethodChoice& method, double platform_sigma, double* unaided = nullptr) {
+  pipeline::OdometryConfig odometry;
+  odometry.lidar_sigma_rotation = platform_sigma;
+  method.apply(odometry);
+  if (unaided != nullptr) *unaided = odometry.lidar_sigma_rotation_unaided;
+  return odometry.lidar_sigma_rotation;
+}
+
+TEST(RunPreset, TheDroverPresetHoldsTheScanMatchsAttitudeToOneHundredthOfARadian) {
+  double unaided = 0;
+  EXPECT_DOUBLE_EQ(lidarRotationSigmaAfter({Preset::kDrover, {}}, 0.05, &unaided), 0.01);
+  EXPECT_DOUBLE_EQ(unaided, 0.05) << "a degenerate sweep without the VIS's factor keeps the platform's sigma";
+  EXPECT_DOUBLE_EQ(lidarRotationSigmaAfter({Preset::kDrover, {}}, 0.002), 0.002) << "a tighter platform stays";
+  EXPECT_DOUBLE_EQ(lidarRotationSigmaAfter({Preset::kDrover, {"lidar-rotation-sigma"}}, 0.05), 0.05);
+  EXPECT_DOUBLE_EQ(lidarRotationSigmaAfter({Preset::kLviSam, {}}, 0.05), 0.05) << "LIO-SAM's correction noise";
+  EXPECT_DOUBLE_EQ(lidarRotationSigmaAfter({Preset::kPlatform, {}}, 0.05), 0.05);
+  const std::vector<std::string> parts = partNames();
+  EXPECT_NE(std::find(parts.begin(), parts.end(), "lidar-rotation-sigma"), parts.end()) << "an ablation row";
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "pipeline/lidar_odometry.hpp"
 #include "sim/imu_model.hpp"
 #include "sim/trajectory.hpp"
+#include "support/rest_then_walk.hpp"
 #include "support/units.hpp"
 
 namespace drover::pipeline {
@@ -21,19 +22,6 @@ using ::drover::test::kSec;
 constexpr Time kSweep = kSec / 10;       // 10 Hz lidar
 constexpr Time kGateFrame = kSec / 15;       // 15 Hz camera
 constexpr Time kBlindFrom = 5 * kSec;    // the VIS slows to 70 % here; the degenerate stretch starts here
-
-// At rest for 1 s, 0.5 m/s^2 to 1 m/s by 3 s, then 1 m/s along x (knots every 0.5 s).
-sim::SplineTrajectory walk() {
-  std::vector<sim::PathSample> knots;
-  for (int k = 0; k <= 24; ++k) {
-    const double t = 0.5 * k;
-    sim::PathSample s;
-    s.t = k * kSec / 2;
-    s.p_world.x() = t <= 1 ? 0.0 : t <= 3 ? 0.25 * (t - 1) * (t - 1) : 1.0 + (t - 3);
-    knots.push_back(s);
-  }
-  return sim::SplineTrajectory(knots);
-}
 
 // The VIS's state at t: the truth until kBlindFrom, then 70 % of the truth's motion and velocity.
 VisualState slowVis(const sim::SplineTrajectory& path, Time t) {
@@ -49,7 +37,7 @@ VisualState slowVis(const sim::SplineTrajectory& path, Time t) {
 
 // Sweeps up to `until` with the truth's pose; from kBlindFrom on degenerate along x when `blind`.
 std::vector<ScanOutcome> run(Time until, bool blind) {
-  const sim::SplineTrajectory path = walk();
+  const sim::SplineTrajectory path = test::restThenWalk(12);  // rest, then 1 m/s along x
   sim::ImuModelConfig m;
   m.noise = false;
   const std::vector<ImuSample> imu = sim::simulateImu(path, m, 1);

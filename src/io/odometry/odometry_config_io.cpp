@@ -161,6 +161,7 @@ pipeline::OdometryConfig loadOdometryConfig(const std::string& yaml_path) {
       .bindSeconds("imu_wait", c.imu_wait, atLeast(0, "s"))
       .bind("lidar_sigma_position", c.lidar_sigma_position)
       .bind("lidar_sigma_rotation", c.lidar_sigma_rotation)
+      .bind("lidar_sigma_rotation_unaided", c.lidar_sigma_rotation_unaided)
       .bind("degenerate_sigma", c.degenerate_sigma)
       .bind("gravity_roll_pitch", c.gravity_roll_pitch)
       .bind("degenerate_pose_from_match", c.degenerate_pose_from_match)

@@ -3,6 +3,7 @@
 // (left out = the default in the component's Config, whose header gives its unit); an unknown key or a bad value is
 // an IoError naming the file, the line and the dotted key. Sections and keys:
 //   odometry: use_imu, deskew, min_points, imu_wait [s], lidar_sigma_position [m], lidar_sigma_rotation [rad],
+//             lidar_sigma_rotation_unaided [rad] (a degenerate sweep without the VIS's factor; 0 = the same),
 //             degenerate_sigma, use_imu_orientation (take a 9-axis unit's orientation at initialisation; false
 //             when it is not of the IMU's acc/gyro frame, as LIO-SAM's extrinsicRPY != extrinsicRot says)
 //             degenerate_pose_from_match (a degenerate match keeps its own pose, as LIO-SAM; default: the smoother's)
