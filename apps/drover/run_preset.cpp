@@ -121,6 +121,7 @@ void applyPreset(Preset preset, pipeline::OdometryConfig& odometry) {
     loop.four_dof_with_imu = false;  // LIO-SAM's keyframe graph (iSAM2) corrects all 6 DoF
     loop.verifier.sigma_fitness_reference = 0.0;  // its loop noise is the ICP fitness score alone
     odometry.static_hold.sigma = 0.0;              // LIO-SAM's IMU graph knows only its first velocity
+    odometry.matcher.degeneracy_threshold_per_correspondence = 0.0;  // its fixed eigenvalue threshold alone
   }
 }
 

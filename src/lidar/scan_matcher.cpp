@@ -159,10 +159,11 @@ void fillStatistics(const ScanMatcherConfig& c, const NormalEquations& ne, Match
   result.information = ne.H / (sigma * sigma);
   result.covariance.setZero();
   result.degenerate_directions.clear();
+  const double threshold = c.degeneracyThreshold(count);
   for (int i = 0; i < 6; ++i) {
     const Vector6d u = eig.eigenvectors().col(i);
     const double lambda = eig.eigenvalues()(i);
-    if (lambda < c.degeneracy_threshold || lambda <= 0.0) {
+    if (lambda < threshold || lambda <= 0.0) {
       result.degenerate_directions.push_back(u);
       result.covariance += c.degenerate_variance * u * u.transpose();
     } else {
@@ -222,6 +223,10 @@ std::string ScanMatcherConfig::validate() const {
       return std::string("scan matcher ") + name + " must be finite and > 0, got " + std::to_string(value);
     }
   }
+  if (!std::isfinite(degeneracy_threshold_per_correspondence) || degeneracy_threshold_per_correspondence < 0.0) {
+    return "scan matcher degeneracy_threshold_per_correspondence must be finite and >= 0, got " +
+           std::to_string(degeneracy_threshold_per_correspondence);
+  }
   if (!(plane_min_aspect >= 0.0 && plane_min_aspect < 1.0)) {
     return "scan matcher plane_min_aspect must be in [0, 1), got " + std::to_string(plane_min_aspect);
   }
@@ -229,6 +234,10 @@ std::string ScanMatcherConfig::validate() const {
     return "scan matcher min_weight must be in [0, 1), got " + std::to_string(min_weight);
   }
   return {};
+}
+
+double ScanMatcherConfig::degeneracyThreshold(int correspondences) const {
+  return std::max(degeneracy_threshold, degeneracy_threshold_per_correspondence * std::max(correspondences, 0));
 }
 
 ScanMatcher::ScanMatcher(const ScanMatcherConfig& config) : config_(config) {
@@ -270,7 +279,7 @@ MatchResult ScanMatcher::align(const FeatureSet& scan, const LocalMap& map,
                           std::to_string(c.min_correspondences));
     }
     const Eigen::SelfAdjointEigenSolver<Matrix6d> eig(ne.H);
-    const Vector6d step = remappedStep(ne, eig, c.degeneracy_threshold);
+    const Vector6d step = remappedStep(ne, eig, c.degeneracyThreshold(ne.edges + ne.planes));
     T = retract(T, step);
     ++result.iterations;
     if (step.head<3>().norm() < c.convergence_translation && step.tail<3>().norm() < c.convergence_rotation) {

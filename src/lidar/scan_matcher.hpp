@@ -54,6 +54,14 @@ struct ScanMatcherConfig {
   double huber_delta = 0.1;                 // [m] Huber kernel threshold
   double degeneracy_threshold = 100.0;      // [-] eigenvalue of J^T J (units of the weighted residual^2 per unit
                                             // of dxi^2) below which a direction is degenerate (LIO-SAM: 100)
+  // [-] ... or below this many times the match's correspondences (edge + plane inliers), whichever is higher. J^T J
+  // sums over correspondences, so LIO-SAM's fixed 100 means less the more points a sweep keeps: at the farm robot's
+  // leaves (2,500-4,400 correspondences) a degenerate corridor's axis reads 20-40, but with 0.1 m leaves (~8,300)
+  // 105-144, and the LIS, no longer told the axis is unknown, stood still there (100 % drift). Per correspondence
+  // the axis reads 0.008-0.02 at either density, real KITTI's weakest direction 0.18-0.21 (HDL-64). 0.02 raises the
+  // threshold only above 5,000 correspondences and changed no sweep's decision on the simulated courses' recorded
+  // runs (bench/RESULTS.md). 0 = LIO-SAM's fixed threshold alone.
+  double degeneracy_threshold_per_correspondence = 0.02;
   int min_edge_features = 10;               // [-] scan edges needed to try (edgeFeatureMinValidNum)
   int min_plane_features = 100;             // [-] scan plane points needed to try (surfFeatureMinValidNum)
   int min_correspondences = 50;             // [-] accepted correspondences needed in every iteration (LIO-SAM 50)
@@ -66,6 +74,8 @@ struct ScanMatcherConfig {
   bool reuse_fits = true;
   // Empty when valid: counts >= 1 (min counts >= 0), every value finite and > 0 (min_weight in [0, 1)).
   std::string validate() const;
+  // The eigenvalue below which a direction of a match with `correspondences` inliers is degenerate.
+  double degeneracyThreshold(int correspondences) const;
 };
 
 enum class MatchStatus {
@@ -88,7 +98,7 @@ struct MatchResult {
   bool degenerate = false;
   Vector6d eigenvalues = Vector6d::Zero();
   int degenerate_count = 0;
-  std::vector<Vector6d> degenerate_directions;  // unit eigenvectors with eigenvalue < threshold, [rho; phi]
+  std::vector<Vector6d> degenerate_directions;  // unit eigenvectors with eigenvalue < degeneracyThreshold(), [rho; phi]
   int edge_inliers = 0;   // accepted edge correspondences in the last iteration
   int plane_inliers = 0;  // accepted plane correspondences in the last iteration
   int fits_computed = 0;  // line/plane fits eigen-decomposed, over all iterations

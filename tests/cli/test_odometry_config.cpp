@@ -214,6 +214,7 @@ TEST(OdometryConfigReader, EveryLocalMapMatcherAndKeyframeKeyReachesItsOwnField)
       "    neighbors: 6\n    max_neighbor_distance: 1.5\n    edge_eigen_ratio: 4\n    plane_tolerance: 0.15\n"
       "    plane_min_aspect: 0.05\n"
       "    kernel: huber\n    min_weight: 0.2\n    huber_delta: 0.05\n    degeneracy_threshold: 50\n"
+      "    degeneracy_threshold_per_correspondence: 0.03\n"
       "    min_edge_features: 5\n    min_plane_features: 60\n    min_correspondences: 40\n"
       "  keyframes:\n    distance: 0.5\n    angle: 0.1\n");
   const lidar::LocalMapConfig& m = c.local_map;
@@ -240,6 +241,7 @@ TEST(OdometryConfigReader, EveryLocalMapMatcherAndKeyframeKeyReachesItsOwnField)
   EXPECT_DOUBLE_EQ(s.min_weight, 0.2);
   EXPECT_DOUBLE_EQ(s.huber_delta, 0.05);
   EXPECT_DOUBLE_EQ(s.degeneracy_threshold, 50.0);
+  EXPECT_DOUBLE_EQ(s.degeneracy_threshold_per_correspondence, 0.03);
   EXPECT_EQ(s.min_edge_features, 5);
   EXPECT_EQ(s.min_plane_features, 60);
   EXPECT_EQ(s.min_correspondences, 40);

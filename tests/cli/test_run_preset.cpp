@@ -133,5 +133,20 @@ TEST(RunPreset, TheDroverPresetHoldsTheScanMatchsAttitudeToOneHundredthOfARadian
   EXPECT_NE(std::find(parts.begin(), parts.end(), "lidar-rotation-sigma"), parts.end()) << "an ablation row";
 }
 
+// The scan matcher's degeneracy test: the lvi-sam preset keeps LIO-SAM's fixed eigenvalue threshold alone; the
+// drover preset and the platform file keep the platform's per-correspondence threshold.
+double perCorrespondenceAfter(const MethodChoice& method) {
+  pipeline::OdometryConfig odometry;
+  odometry.matcher.degeneracy_threshold_per_correspondence = 0.03;
+  method.apply(odometry);
+  return odometry.matcher.degeneracy_threshold_per_correspondence;
+}
+
+TEST(RunPreset, TheLviSamPresetTestsDegeneracyWithLioSamsFixedThresholdAlone) {
+  EXPECT_DOUBLE_EQ(perCorrespondenceAfter({Preset::kLviSam, {}}), 0.0);
+  EXPECT_DOUBLE_EQ(perCorrespondenceAfter({Preset::kDrover, {}}), 0.03);
+  EXPECT_DOUBLE_EQ(perCorrespondenceAfter({Preset::kPlatform, {}}), 0.03);
+}
+
 }  // namespace
 }  // namespace drover::cli

@@ -82,6 +82,7 @@ void bindMatcher(YamlSection& s, lidar::ScanMatcherConfig& c, EnumStrings& e) {
       .bind("min_weight", c.min_weight)
       .bind("huber_delta", c.huber_delta)
       .bind("degeneracy_threshold", c.degeneracy_threshold)
+      .bind("degeneracy_threshold_per_correspondence", c.degeneracy_threshold_per_correspondence)
       .bind("min_edge_features", c.min_edge_features)
       .bind("min_plane_features", c.min_plane_features)
       .bind("min_correspondences", c.min_correspondences);

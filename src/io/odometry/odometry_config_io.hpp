@@ -15,7 +15,8 @@
 //                   full_leaf [m], sub_regions, max_edges_per_region, ... (lidar/feature_extractor.hpp)
 //     local_map:    surrounding_radius [m], keyframe_density [m], recent_window [s], edge_leaf, plane_leaf [m],
 //                   retire_radius [m], retire_age [s], ... (lidar/local_map.hpp)
-//     matcher:      max_iterations, degeneracy_threshold, kernel (lio-sam | huber), ...
+//     matcher:      max_iterations, degeneracy_threshold, degeneracy_threshold_per_correspondence, kernel
+//                   (lio-sam | huber), ...
 //     keyframes:    distance [m], angle [rad]
 //     imu:          gyro_noise_density, acc_noise_density, gyro_bias_random_walk, acc_bias_random_walk, gravity
 //     smoother:     window, max_iterations, ...
