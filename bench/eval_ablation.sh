@@ -21,7 +21,7 @@ BUILD_DIR=${DROVER_BUILD_DIR:-build}
 OUT_ROOT=${DROVER_OUT:-out}
 DROVER="$BUILD_DIR/apps/drover/drover"
 read -r -a COURSES <<< "${ABLATION_COURSES:-corridor white-walls lighting farm farm-2 farm-3}"
-read -r -a ROWS <<< "${ABLATION_ROWS:-lis vis lvi-sam drover drover-vo-factor drover-vis-gates drover-visual-yaw-prior drover-scan-context drover-radius-search drover-four-dof drover-loop-fitness-sigma drover-vis-carried-sigma drover-depth-factor drover-superpoint drover-keyframe-interval drover-lidar-rotation-sigma}"
+read -r -a ROWS <<< "${ABLATION_ROWS:-lis vis lvi-sam drover drover-vo-factor drover-vis-guess drover-vis-gates drover-keyframe-gap-speed drover-visual-yaw-prior drover-scan-context drover-radius-search drover-four-dof drover-loop-fitness-sigma drover-vis-carried-sigma drover-depth-factor drover-superpoint drover-lk-min-eigenvalue drover-keyframe-interval drover-lidar-rotation-sigma}"
 read -r -a EXTRA <<< "${ABLATION_DROVER_EXTRA:-}"
 LOOP_FLAG=()
 [ "${ABLATION_LOOPS:-1}" = 1 ] || LOOP_FLAG=(--no-loop)
