@@ -196,5 +196,11 @@ TEST(OdometryConfigReader, ANegativeUnaidedLidarRotationSigmaIsAnErrorNamingTheK
   EXPECT_TRUE(has(e, "section 'odometry'") && has(e, "lidar_sigma_rotation_unaided must be finite and >= 0")) << e;
 }
 
+TEST(OdometryConfigReader, ANegativePerCorrespondenceDegeneracyThresholdIsAnErrorNamingTheKey) {
+  test::TempDir dir;
+  const std::string e = errorOf(dir, "odometry:\n  matcher:\n    degeneracy_threshold_per_correspondence: -0.02\n");
+  EXPECT_TRUE(has(e, "degeneracy_threshold_per_correspondence must be finite and >= 0")) << e;
+}
+
 }  // namespace
 }  // namespace drover::io

@@ -11,7 +11,6 @@
 
 #include "pipeline/imu_fusion.hpp"
 #include "pipeline/lidar_odometry.hpp"
-#include "sim/imu_model.hpp"
 #include "sim/trajectory.hpp"
 #include "support/rest_then_walk.hpp"
 #include "support/units.hpp"
@@ -29,9 +28,7 @@ constexpr double kTiltDeg = 1.0;
 // The smoother's pitch error [deg] at kUntil.
 double pitchErrorDeg(double sigma_rotation, double sigma_unaided, bool with_vis) {
   const sim::SplineTrajectory path = test::restThenWalk(8);  // rest, then 1 m/s along x
-  sim::ImuModelConfig m;
-  m.noise = false;
-  const std::vector<ImuSample> imu = sim::simulateImu(path, m, 1);
+  const std::vector<ImuSample> imu = test::exactImu(path);
   OdometryConfig config;
   config.use_imu = true;
   config.lidar_sigma_rotation = sigma_rotation;

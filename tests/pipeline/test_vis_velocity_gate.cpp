@@ -10,7 +10,6 @@
 
 #include "pipeline/imu_fusion.hpp"
 #include "pipeline/lidar_odometry.hpp"
-#include "sim/imu_model.hpp"
 #include "sim/trajectory.hpp"
 #include "support/rest_then_walk.hpp"
 #include "support/units.hpp"
@@ -38,9 +37,7 @@ VisualState slowVis(const sim::SplineTrajectory& path, Time t) {
 // Sweeps up to `until` with the truth's pose; from kBlindFrom on degenerate along x when `blind`.
 std::vector<ScanOutcome> run(Time until, bool blind) {
   const sim::SplineTrajectory path = test::restThenWalk(12);  // rest, then 1 m/s along x
-  sim::ImuModelConfig m;
-  m.noise = false;
-  const std::vector<ImuSample> imu = sim::simulateImu(path, m, 1);
+  const std::vector<ImuSample> imu = test::exactImu(path);
   OdometryConfig config;
   config.use_imu = true;
   ImuFusion fusion(config, Eigen::Isometry3d::Identity());
